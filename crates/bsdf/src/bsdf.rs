@@ -1,0 +1,193 @@
+//! The BSDF interface.
+//!
+//! Directions are unit vectors in the local shading frame (z = shading normal), both
+//! pointing away from the surface: `wo` is the direction the path arrives from (toward the
+//! camera when tracing radiance), `wi` the direction it continues to (toward the light).
+//! In the papers' notation f(i, o) with i the light direction: `eval(wo, wi)` = f(i = wi,
+//! o = wo) in radiance mode.
+//!
+//! `sample` returns the weight f·|cos θ_i|/pdf, the solid-angle pdf and the lobe it drew
+//! from. For a delta lobe the pdf is the discrete probability of choosing that lobe and the
+//! weight is the lobe's throughput; `eval` and `pdf` never include delta lobes.
+//!
+//! Stochastic models (a body term estimated with one microfacet, a random walk between
+//! microfacets) are first-class: every call receives a [`RandomSource`], deterministic
+//! models simply ignore it, and [`Bsdf::is_stochastic`] says which kind a model is. Their
+//! `eval` is an unbiased estimate, their `pdf` is exact, and their `sample` weight is an
+//! unbiased estimate of f·|cos|/pdf.
+
+use crate::math::rng::RandomSource;
+use crate::math::spectrum::Spectrum;
+use crate::math::Vec3;
+
+/// Which quantity a path carries. Only refraction distinguishes them: WMLT07's BTDF is not
+/// reciprocal, f_t(i,o)/η_o² = f_t(o,i)/η_i² (ERRATA 11).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TransportMode {
+    /// Paths traced from the camera; `eval(wo, wi)` = f(i = wi, o = wo).
+    #[default]
+    Radiance,
+    /// Paths traced from the lights; `eval(wo, wi)` = f(i = wo, o = wi).
+    Importance,
+}
+
+/// Lobe classification flags.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
+pub struct LobeFlags(pub u8);
+
+impl LobeFlags {
+    pub const NONE: LobeFlags = LobeFlags(0);
+    pub const REFLECTION: LobeFlags = LobeFlags(1);
+    pub const TRANSMISSION: LobeFlags = LobeFlags(2);
+    pub const DIFFUSE: LobeFlags = LobeFlags(4);
+    pub const GLOSSY: LobeFlags = LobeFlags(8);
+    pub const DELTA: LobeFlags = LobeFlags(16);
+
+    pub const DIFFUSE_REFLECTION: LobeFlags = LobeFlags(1 | 4);
+    pub const GLOSSY_REFLECTION: LobeFlags = LobeFlags(1 | 8);
+    pub const GLOSSY_TRANSMISSION: LobeFlags = LobeFlags(2 | 8);
+    pub const DELTA_REFLECTION: LobeFlags = LobeFlags(1 | 16);
+    pub const DELTA_TRANSMISSION: LobeFlags = LobeFlags(2 | 16);
+
+    #[inline]
+    pub fn contains(self, o: LobeFlags) -> bool {
+        self.0 & o.0 == o.0
+    }
+
+    #[inline]
+    pub fn intersects(self, o: LobeFlags) -> bool {
+        self.0 & o.0 != 0
+    }
+
+    #[inline]
+    pub fn is_delta(self) -> bool {
+        self.intersects(LobeFlags::DELTA)
+    }
+
+    /// True when the BSDF has a non-delta component (so `eval`/`pdf` are meaningful).
+    #[inline]
+    pub fn has_smooth_part(self) -> bool {
+        self.intersects(LobeFlags(LobeFlags::DIFFUSE.0 | LobeFlags::GLOSSY.0))
+    }
+
+    pub fn describe(self) -> String {
+        let mut v = Vec::new();
+        for (f, n) in [
+            (LobeFlags::DELTA, "delta"),
+            (LobeFlags::GLOSSY, "glossy"),
+            (LobeFlags::DIFFUSE, "diffuse"),
+            (LobeFlags::REFLECTION, "reflection"),
+            (LobeFlags::TRANSMISSION, "transmission"),
+        ] {
+            if self.intersects(f) {
+                v.push(n);
+            }
+        }
+        v.join("+")
+    }
+}
+
+impl std::ops::BitOr for LobeFlags {
+    type Output = LobeFlags;
+    fn bitor(self, o: LobeFlags) -> LobeFlags {
+        LobeFlags(self.0 | o.0)
+    }
+}
+
+/// Per-query context.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BsdfContext {
+    pub mode: TransportMode,
+}
+
+impl BsdfContext {
+    pub const RADIANCE: BsdfContext = BsdfContext {
+        mode: TransportMode::Radiance,
+    };
+    pub const IMPORTANCE: BsdfContext = BsdfContext {
+        mode: TransportMode::Importance,
+    };
+}
+
+/// Result of [`Bsdf::sample`].
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// The sampled direction.
+    pub wi: Vec3,
+    /// f·|cos θ_i| / pdf (for delta lobes: the lobe's throughput).
+    pub weight: Spectrum,
+    /// Solid-angle density of `wi` (for delta lobes: the lobe-selection probability).
+    pub pdf: f64,
+    /// The lobe that produced the sample.
+    pub lobe: LobeFlags,
+    /// Relative index η_i/η_o crossed by the sample (1 for reflection), for the
+    /// integrator's Russian roulette on radiance.
+    pub eta: f64,
+}
+
+/// A bidirectional scattering distribution function in the local frame.
+pub trait Bsdf: Send + Sync {
+    /// The lobes this BSDF has.
+    fn flags(&self) -> LobeFlags;
+
+    /// True when `eval` is a stochastic (unbiased) estimate that consumes random numbers.
+    fn is_stochastic(&self) -> bool {
+        false
+    }
+
+    /// f(wo, wi) without the cosine factor; excludes delta lobes.
+    fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum;
+
+    /// Draws `wi` for the given `wo`.
+    fn sample(&self, wo: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource)
+        -> Option<BsdfSample>;
+
+    /// Solid-angle density with which `sample` produces `wi` (non-delta lobes only).
+    fn pdf(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f64;
+
+    /// A converged value of f(wo, wi) with its standard error. Deterministic models return
+    /// `eval` and zero; stochastic ones average `samples` independent estimates.
+    fn eval_estimate(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        ctx: &BsdfContext,
+        samples: usize,
+        rng: &mut dyn RandomSource,
+    ) -> (Spectrum, Spectrum) {
+        if !self.is_stochastic() {
+            return (self.eval(wo, wi, ctx, rng), Spectrum::ZERO);
+        }
+        mean_and_stderr(samples, || self.eval(wo, wi, ctx, rng))
+    }
+
+    /// Typical angular width of the glossy lobes (radians-like scale), used to size
+    /// validation bins; 1 for diffuse models.
+    fn lobe_width(&self) -> f64 {
+        1.0
+    }
+
+    /// Relative index η (inside over outside) for transmissive models, else `None`.
+    fn relative_ior(&self) -> Option<f64> {
+        None
+    }
+
+    /// Short description of the model and its parameters.
+    fn describe(&self) -> String;
+}
+
+/// Mean and standard error of `n` spectrum-valued draws.
+pub fn mean_and_stderr(n: usize, mut draw: impl FnMut() -> Spectrum) -> (Spectrum, Spectrum) {
+    let n = n.max(2);
+    let mut s = Spectrum::ZERO;
+    let mut s2 = Spectrum::ZERO;
+    for _ in 0..n {
+        let v = draw();
+        s += v;
+        s2 += v * v;
+    }
+    let nf = n as f64;
+    let mean = s / nf;
+    let var = (s2 / nf - mean * mean).map(|v| v.max(0.0)) * (nf / (nf - 1.0));
+    (mean, (var / nf).map(f64::sqrt))
+}

@@ -1,0 +1,39 @@
+//! # facette-bsdf
+//!
+//! The material library of facette: microfacet distributions, masking and Fresnel terms
+//! (the *microfacet core*), the BSDF models of the papers facette implements, and the
+//! statistical harness that verifies them. It does not depend on any renderer code.
+//!
+//! - [`math`]: vectors and frames, the [`Spectrum`](math::spectrum::Spectrum) type, a
+//!   bit-stable RNG, special functions, quadrature and sampling warps.
+//! - [`microfacet`]: Beckmann, GGX (anisotropic), the Gaussian of Oren–Nayar/Simonot and
+//!   Phong, with Smith Λ/G1, samplers of D(m)|m·n| and of visible normals; masking choices;
+//!   KSK01's half-vector densities; the shared specular microfacet lobe.
+//! - [`fresnel`]: exact dielectric and conductor Fresnel, Schlick, r_e and r_i.
+//! - [`bsdf`]: the BSDF interface (`eval`, `sample`, `pdf`, flags, transport mode,
+//!   stochastic evaluation).
+//! - [`models`]: one file per model.
+//! - [`spec`]: materials written as TOML tables (`{type = "dielectric", …}`), validated and
+//!   built into BSDFs.
+//! - [`validation`]: chi-square goodness of fit, normalization, reciprocity, energy and
+//!   NaN sweeps — the checks behind `facette validate` and the test suite.
+//!
+//! Paper references in doc comments use the short names of `../shared/papers/README.md`:
+//! WMLT07, KSK01, IL18, TSBRM, CCM19.
+
+// `!(x > 0.0)` is used on purpose throughout: it is true for NaN, which must be rejected too.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod bsdf;
+pub mod error;
+pub mod fresnel;
+pub mod math;
+pub mod microfacet;
+pub mod spec;
+
+pub mod validation;
+
+pub use bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
+pub use error::{ParamError, ParamResult};
+pub use math::spectrum::Spectrum;
+pub use math::{Vec2, Vec3};

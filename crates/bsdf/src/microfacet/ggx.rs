@@ -1,0 +1,149 @@
+//! GGX / Trowbridge–Reitz, anisotropic  [WMLT07 eqs. 33–36; IL18 eqs. 21–22, 29, 31].
+//!
+//! | parameter | meaning | range |
+//! |---|---|---|
+//! | `alpha_x`, `alpha_y` | width along the tangent x / bitangent y axis (unitless) | (0, 10] |
+//!
+//! IL18 eq. 21 as printed swaps σ_x and σ_y in the denominator and mixes α with σ
+//! (ERRATA 2); this is the standard form, consistent with eq. 16 and with the sampling of
+//! eqs. 29 and 31, and the normalization test proves it. Eq. 31 uses ξ1 twice (ERRATA 3):
+//! θ_m uses the second, independent number.
+
+use super::{normal_from_slopes, visible_density, Distribution};
+use crate::error::{check_range, Bounds, ParamResult};
+use crate::math::{fmt_num, Vec2, Vec3, PI, TWO_PI};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ggx {
+    ax: f64,
+    ay: f64,
+}
+
+impl Ggx {
+    pub fn new(alpha_x: f64, alpha_y: f64) -> ParamResult<Self> {
+        check_range("alpha_u", alpha_x, 0.0, 10.0, Bounds::OpenClosed)?;
+        check_range("alpha_v", alpha_y, 0.0, 10.0, Bounds::OpenClosed)?;
+        Ok(Ggx {
+            ax: alpha_x,
+            ay: alpha_y,
+        })
+    }
+
+    pub fn isotropic(alpha: f64) -> ParamResult<Self> {
+        check_range("alpha", alpha, 0.0, 10.0, Bounds::OpenClosed)?;
+        Self::new(alpha, alpha)
+    }
+
+    /// Isotropic GGX without validation, for internal proposals (width must be > 0).
+    pub(crate) fn isotropic_unchecked(alpha: f64) -> Self {
+        Ggx {
+            ax: alpha,
+            ay: alpha,
+        }
+    }
+
+    pub fn alpha_x(&self) -> f64 {
+        self.ax
+    }
+
+    pub fn alpha_y(&self) -> f64 {
+        self.ay
+    }
+
+    pub fn scaled(&self, s: f64) -> Self {
+        Ggx {
+            ax: self.ax * s,
+            ay: self.ay * s,
+        }
+    }
+}
+
+impl Distribution for Ggx {
+    /// D(m) = 1 / (π α_x α_y z⁴ (1 + (x²/α_x² + y²/α_y²)/z²)²)  [IL18 eq. 21 corrected;
+    /// WMLT07 eq. 33 when isotropic].
+    #[inline]
+    fn d(&self, m: Vec3) -> f64 {
+        if m.z <= 0.0 {
+            return 0.0;
+        }
+        // Written as 1/(π α_x α_y (x²/α_x² + y²/α_y² + z²)²), finite up to the horizon.
+        let t = m.x * m.x / (self.ax * self.ax) + m.y * m.y / (self.ay * self.ay) + m.z * m.z;
+        1.0 / (PI * self.ax * self.ay * t * t)
+    }
+
+    /// Λ(v) = (−1 + √(1 + α_v² tan² θ_v)) / 2  [IL18 eq. 22; WMLT07 eq. 34].
+    #[inline]
+    fn lambda(&self, v: Vec3) -> f64 {
+        let s2 = self.ax * self.ax * v.x * v.x + self.ay * self.ay * v.y * v.y;
+        let z2 = v.z * v.z;
+        if z2 == 0.0 {
+            return if s2 > 0.0 { f64::INFINITY } else { 0.0 };
+        }
+        let t = s2 / z2; // α_v² tan² θ_v
+                         // (√(1+t) − 1)/2 = t / (2(√(1+t) + 1)): no cancellation for small t.
+        t / (2.0 * ((1.0 + t).sqrt() + 1.0))
+    }
+
+    /// Samples D(m)|m·n|: unit slope radius r = √(ξ1/(1−ξ1)) at angle 2πξ2, stretched by
+    /// (α_x, α_y) — IL18 eqs. 29 and 31 (corrected, ERRATA 3) in slope space, and WMLT07
+    /// eqs. 35–36 when isotropic.
+    #[inline]
+    fn sample_normal(&self, u: Vec2) -> Vec3 {
+        let r = (u.x / (1.0 - u.x)).sqrt();
+        let (s, c) = (TWO_PI * u.y).sin_cos();
+        normal_from_slopes(r * c * self.ax, r * s * self.ay)
+    }
+
+    #[inline]
+    fn pdf_normal(&self, m: Vec3) -> f64 {
+        self.d(m) * m.z.max(0.0)
+    }
+
+    fn has_visible_sampling(&self) -> bool {
+        true
+    }
+
+    /// Heitz 2018, "Sampling the GGX Distribution of Visible Normals" (JCGT 7(4)):
+    /// stretch the view, sample the projected hemisphere, unstretch.
+    #[inline]
+    fn sample_visible(&self, v: Vec3, u: Vec2) -> Vec3 {
+        let vh = Vec3::new(self.ax * v.x, self.ay * v.y, v.z.max(0.0)).normalize();
+        let lensq = vh.x * vh.x + vh.y * vh.y;
+        let t1 = if lensq > 1e-20 {
+            Vec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
+        } else {
+            Vec3::X
+        };
+        let t2 = vh.cross(t1);
+        let r = u.x.sqrt();
+        let (s, c) = (TWO_PI * u.y).sin_cos();
+        let p1 = r * c;
+        let mut p2 = r * s;
+        let h = 0.5 * (1.0 + vh.z);
+        p2 = (1.0 - h) * (1.0 - p1 * p1).max(0.0).sqrt() + h * p2;
+        let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
+        let ne = Vec3::new(self.ax * nh.x, self.ay * nh.y, nh.z.max(1e-300));
+        ne.normalize()
+    }
+
+    #[inline]
+    fn pdf_visible(&self, v: Vec3, m: Vec3) -> f64 {
+        visible_density(self.lambda(v), v, m, self.d(m))
+    }
+
+    fn typical_width(&self) -> f64 {
+        (self.ax * self.ay).sqrt()
+    }
+
+    fn describe(&self) -> String {
+        if self.ax == self.ay {
+            format!("ggx(alpha={})", fmt_num(self.ax))
+        } else {
+            format!(
+                "ggx(alpha_u={}, alpha_v={})",
+                fmt_num(self.ax),
+                fmt_num(self.ay)
+            )
+        }
+    }
+}

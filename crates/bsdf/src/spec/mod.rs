@@ -1,0 +1,44 @@
+//! Materials and distributions written as TOML tables — the syntax shared by the command
+//! line (`--material '{type = "dielectric", alpha = 0.3}'`) and the scene files. Every key
+//! is validated; unknown keys and values are errors that list the valid ones.
+
+pub mod microfacet;
+pub mod params;
+
+pub use params::Params;
+
+use crate::error::ParamError;
+
+/// Parses `{key = value, …}` (a TOML inline table) into a table.
+pub fn parse_inline_table(text: &str) -> Result<toml::Table, ParamError> {
+    let src = format!("value = {}", text.trim());
+    let mut t: toml::Table = toml::from_str(&src).map_err(|e| {
+        ParamError::Invalid(format!(
+            "not a TOML inline table ({{key = value, ...}}): {}",
+            e.message()
+        ))
+    })?;
+    match t.remove("value") {
+        Some(toml::Value::Table(tab)) => Ok(tab),
+        Some(other) => Err(ParamError::Invalid(format!(
+            "expected a TOML inline table {{key = value, ...}}, got a {}",
+            other.type_str()
+        ))),
+        None => Err(ParamError::Invalid("empty table".into())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inline_tables_parse_and_errors_are_readable() {
+        let t = parse_inline_table(r#"{type = "lambert", reflectance = [0.1, 0.2, 0.3]}"#).unwrap();
+        assert_eq!(t["type"].as_str(), Some("lambert"));
+        let e = parse_inline_table("{type = }").unwrap_err().to_string();
+        assert!(e.contains("not a TOML inline table"), "{e}");
+        let e = parse_inline_table("3").unwrap_err().to_string();
+        assert!(e.contains("got a integer"), "{e}");
+    }
+}

@@ -1,0 +1,304 @@
+//! Ready-made check suites: the microfacet core (distributions, masking, Fresnel) run by
+//! `facette validate` with no material and by the test suite.
+
+use super::chi2::Chi2Config;
+use super::distribution_checks::{check_distribution, DistributionCheckOptions};
+use super::{rel_err, Check, Report, Verdict};
+use crate::fresnel::conductor::{fresnel_conductor_scalar, METALS};
+use crate::fresnel::diffuse_averages::{
+    external_diffuse_reflectance, external_diffuse_reflectance_numeric,
+    internal_diffuse_reflectance, internal_diffuse_reflectance_numeric,
+};
+use crate::fresnel::schlick::fresnel_schlick_dielectric;
+use crate::fresnel::{fresnel_conductor, fresnel_dielectric};
+use crate::math::rng::{Pcg32, RandomSource};
+use crate::math::spherical_direction;
+use crate::math::warp::square_to_uniform_sphere;
+use crate::microfacet::{Beckmann, BeckmannG1, Gaussian, Ggx, Masking, Ndf, Phong, PhongG1};
+use rayon::prelude::*;
+
+/// Options shared by the suites.
+#[derive(Clone, Copy, Debug)]
+pub struct SuiteOptions {
+    pub chi2_samples: usize,
+    pub seed: u64,
+}
+
+impl Default for SuiteOptions {
+    fn default() -> Self {
+        SuiteOptions {
+            chi2_samples: 1_000_000,
+            seed: 7,
+        }
+    }
+}
+
+/// Distribution families of the core suite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    Beckmann,
+    Ggx,
+    Gaussian,
+    Phong,
+}
+
+/// The distributions the core suite checks: roughness from 0.01 to 1.5, anisotropic pairs.
+pub fn distribution_grid(family: Family) -> Vec<Ndf> {
+    let alphas = [0.01, 0.1, 0.5, 1.0, 1.5];
+    let pairs = [(0.05, 0.5), (1.5, 0.2)];
+    match family {
+        Family::Beckmann => {
+            let mut v: Vec<Ndf> = alphas
+                .iter()
+                .map(|&a| Ndf::Beckmann(Beckmann::isotropic(a).unwrap()))
+                .collect();
+            v.extend(
+                pairs
+                    .iter()
+                    .map(|&(x, y)| Ndf::Beckmann(Beckmann::new(x, y).unwrap())),
+            );
+            v.push(Ndf::Beckmann(
+                Beckmann::isotropic(0.3)
+                    .unwrap()
+                    .with_g1(BeckmannG1::Rational),
+            ));
+            v
+        }
+        Family::Ggx => {
+            let mut v: Vec<Ndf> = alphas
+                .iter()
+                .map(|&a| Ndf::Ggx(Ggx::isotropic(a).unwrap()))
+                .collect();
+            v.extend(
+                pairs
+                    .iter()
+                    .map(|&(x, y)| Ndf::Ggx(Ggx::new(x, y).unwrap())),
+            );
+            v
+        }
+        Family::Gaussian => alphas
+            .iter()
+            .map(|&s| Ndf::Gaussian(Gaussian::new(s).unwrap()))
+            .collect(),
+        Family::Phong => [0.01, 0.1, 0.5, 1.0]
+            .iter()
+            .map(|&a| Ndf::Phong(Phong::from_beckmann_alpha(a).unwrap()))
+            .chain(std::iter::once(Ndf::Phong(
+                Phong::new(20.0).unwrap().with_g1(PhongG1::Numeric),
+            )))
+            .collect(),
+    }
+}
+
+/// Checks of every distribution of a family.
+pub fn distribution_suite(family: Family, opts: &SuiteOptions) -> Report {
+    let dopts = DistributionCheckOptions {
+        chi2: Chi2Config {
+            samples: opts.chi2_samples,
+            seed: opts.seed,
+            ..Chi2Config::default()
+        },
+        ..DistributionCheckOptions::default()
+    };
+    let mut r = Report::new();
+    for d in distribution_grid(family) {
+        r.extend(check_distribution(&d, &dopts));
+    }
+    r
+}
+
+/// Fresnel checks: r_e/r_i closed forms against quadrature, the dielectric against its
+/// amplitude form and its limits, conductors, Schlick's error.
+pub fn fresnel_checks() -> Vec<Check> {
+    let mut out = Vec::new();
+    let ns = [1.01, 1.2, 1.33, 1.5, 2.0, 3.0];
+    let mut worst_e: (f64, f64) = (0.0, 0.0);
+    let mut worst_i: (f64, f64) = (0.0, 0.0);
+    let mut values = Vec::new();
+    for &n in &ns {
+        let e = (external_diffuse_reflectance(n) - external_diffuse_reflectance_numeric(n)).abs();
+        let i = (internal_diffuse_reflectance(n) - internal_diffuse_reflectance_numeric(n)).abs();
+        if e >= worst_e.0 {
+            worst_e = (e, n);
+        }
+        if i >= worst_i.0 {
+            worst_i = (i, n);
+        }
+        values.push(format!("r_e({n}) = {:.6}", external_diffuse_reflectance(n)));
+    }
+    out.push(Check::new(
+        "fresnel",
+        "r_e closed form [IL18 eq. 11] vs quadrature, n_i ∈ {1.01, 1.2, 1.33, 1.5, 2, 3}",
+        format!(
+            "max |error| {:.1e} at n_i = {} (tolerance 1e-5); {}",
+            worst_e.0,
+            worst_e.1,
+            values.join(", ")
+        ),
+        Verdict::from_bool(worst_e.0 <= 1e-5),
+    ));
+    out.push(Check::new(
+        "fresnel",
+        "r_i from n_i²(1 − r_i) = 1 − r_e vs quadrature with total internal reflection",
+        format!(
+            "max |error| {:.1e} at n_i = {} (tolerance 1e-5)",
+            worst_i.0, worst_i.1
+        ),
+        Verdict::from_bool(worst_i.0 <= 1e-5),
+    ));
+
+    // Dielectric: bounds, normal incidence, reciprocity of the two sides, TIR, η → 1.
+    let mut problems = Vec::new();
+    for &eta in &[1.0 + 1e-9f64, 1.01, 1.33, 1.5, 2.4] {
+        let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+        if (fresnel_dielectric(1.0, eta) - f0).abs() > 1e-12 {
+            problems.push(format!("F(0°, {eta}) ≠ F0"));
+        }
+        for k in 0..=90 {
+            let ti = (k as f64).to_radians();
+            let ci = ti.cos();
+            let f = fresnel_dielectric(ci, eta);
+            if !(0.0..=1.0).contains(&f) {
+                problems.push(format!("F({k}°, {eta}) = {f}"));
+            }
+            // Same interface seen from inside along the refracted ray gives the same F.
+            let st = ti.sin() / eta;
+            let ct = (1.0 - st * st).sqrt();
+            let back = fresnel_dielectric(ct, 1.0 / eta);
+            if k < 90 && (back - f).abs() > 1e-9 {
+                problems.push(format!("F inside ≠ outside at {k}°, η = {eta}"));
+            }
+        }
+        let crit = (1.0 / eta).asin();
+        if eta > 1.0001 && fresnel_dielectric((crit + 0.01).cos(), 1.0 / eta) != 1.0 {
+            problems.push(format!("no TIR beyond the critical angle for η = {eta}"));
+        }
+    }
+    out.push(Check::new(
+        "fresnel",
+        "dielectric [WMLT07 eq. 22]: 0 ≤ F ≤ 1, F(0°) = ((η−1)/(η+1))², same F from both sides, TIR, η → 1",
+        if problems.is_empty() { "all hold".into() } else { problems.join("; ") },
+        Verdict::from_bool(problems.is_empty()),
+    ));
+
+    let mut problems = Vec::new();
+    for k in 0..=100 {
+        let c = k as f64 / 100.0;
+        if (fresnel_conductor_scalar(c, 1.5, 0.0) - fresnel_dielectric(c, 1.5)).abs() > 1e-12 {
+            problems.push(format!("k = 0 differs from dielectric at cos {c}"));
+        }
+        for m in METALS {
+            let f = fresnel_conductor(c, m.eta(), m.k());
+            if !(f.min_component() >= 0.0 && f.max_component() <= 1.0) {
+                problems.push(format!("{} out of [0,1] at cos {c}", m.name));
+            }
+        }
+    }
+    out.push(Check::new(
+        "fresnel",
+        "conductor: reduces to the dielectric when k = 0; presets within [0, 1]",
+        if problems.is_empty() {
+            "all hold".into()
+        } else {
+            problems.join("; ")
+        },
+        Verdict::from_bool(problems.is_empty()),
+    ));
+
+    let mut worst: (f64, f64) = (0.0, 0.0);
+    for k in 0..=900 {
+        let c = (k as f64 / 10.0).to_radians().cos();
+        let e = (fresnel_schlick_dielectric(c, 1.5) - fresnel_dielectric(c, 1.5)).abs();
+        if e > worst.0 {
+            worst = (e, k as f64 / 10.0);
+        }
+    }
+    out.push(Check::new(
+        "fresnel",
+        "Schlick vs exact for η = 1.5",
+        format!("max |error| {:.4} at θ = {}°", worst.0, worst.1),
+        Verdict::Info,
+    ));
+    out
+}
+
+/// Masking checks on random configurations: bounds, symmetry, sidedness.
+pub fn masking_checks(seed: u64) -> Vec<Check> {
+    let dists = [
+        Ndf::Beckmann(Beckmann::new(0.3, 0.8).unwrap()),
+        Ndf::Ggx(Ggx::new(0.05, 0.5).unwrap()),
+        Ndf::Phong(Phong::new(30.0).unwrap()),
+        Ndf::Gaussian(Gaussian::new(0.4).unwrap()),
+    ];
+    let forms = [
+        Masking::SmithSeparable,
+        Masking::SmithCorrelated,
+        Masking::VCavity,
+        Masking::Kelemen,
+    ];
+    forms
+        .par_iter()
+        .map(|mk| {
+            let mut rng = Pcg32::new(seed, 11);
+            let mut problems = Vec::new();
+            let mut evaluated = 0usize;
+            for d in &dists {
+                if mk.is_smith() && !d.supports_smith() {
+                    continue;
+                }
+                for _ in 0..100_000 {
+                    let i = square_to_uniform_sphere(rng.next_2d());
+                    let o = square_to_uniform_sphere(rng.next_2d());
+                    let m = spherical_direction(
+                        rng.next_f64() * 1.5,
+                        rng.next_f64() * std::f64::consts::TAU,
+                    );
+                    let g = mk.g(d, i, o, m);
+                    let g2 = mk.g(d, o, i, m);
+                    evaluated += 1;
+                    let sided = (i.dot(m) * i.z > 0.0) && (o.dot(m) * o.z > 0.0);
+                    if !(0.0..=1.0).contains(&g) {
+                        problems.push(format!("G = {g}"));
+                    } else if rel_err(g, g2) > 1e-12 && (g - g2).abs() > 1e-15 {
+                        problems.push(format!("G not symmetric: {g} vs {g2}"));
+                    } else if !sided && g != 0.0 {
+                        problems.push("G > 0 for a back-facing configuration".into());
+                    }
+                    if problems.len() > 3 {
+                        break;
+                    }
+                }
+            }
+            Check::new(
+                format!("masking {}", mk.name()),
+                "0 ≤ G ≤ 1, G(i,o,m) = G(o,i,m), G = 0 on back-facing m (WMLT07 eqs. 5–7)",
+                if problems.is_empty() {
+                    format!("{evaluated} random configurations hold")
+                } else {
+                    problems.join("; ")
+                },
+                Verdict::from_bool(problems.is_empty()),
+            )
+        })
+        .collect()
+}
+
+/// The whole core suite, optionally restricted to one family.
+pub fn core_suite(opts: &SuiteOptions, only: Option<Family>) -> Report {
+    let mut r = Report::new();
+    for fam in [
+        Family::Beckmann,
+        Family::Ggx,
+        Family::Gaussian,
+        Family::Phong,
+    ] {
+        if only.is_none() || only == Some(fam) {
+            r.extend(distribution_suite(fam, opts).checks);
+        }
+    }
+    if only.is_none() {
+        r.extend(masking_checks(opts.seed));
+        r.extend(fresnel_checks());
+    }
+    r
+}

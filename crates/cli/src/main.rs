@@ -1,0 +1,41 @@
+//! `facette`: the command-line front of the library, renderer and lab. Argument parsing and
+//! progress reporting only; each subcommand is a thin call into a crate.
+
+mod cmd_validate;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "facette",
+    version,
+    about = "A renderer and lab for microfacet materials",
+    long_about = "facette evaluates, samples, validates and renders the microfacet materials of \
+                  Walter et al. 2007, Kelemen & Szirmay-Kalos 2001, Simonot / Meneveaux et al. \
+                  (interfaced Lambertian) and Chermain et al. 2019 (glints)."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Statistical validation: the microfacet core suite, one distribution, or a material.
+    Validate(cmd_validate::ValidateArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Validate(a) => cmd_validate::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
