@@ -1,9 +1,11 @@
 //! Kernel benchmarks of the microfacet core: ns per D, G1, D + G1, sample and pdf for each
-//! distribution (one thread). Results are recorded in docs/performance.md.
+//! distribution (one thread). Each iteration evaluates a batch of 256 different inputs whose
+//! results are accumulated, and criterion reports the time per element — the throughput of
+//! independent evaluations, as a renderer issues them. Results are in docs/performance.md.
 
-use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use facette_bsdf::math::spherical_direction;
-use facette_bsdf::microfacet::{Beckmann, Distribution, Gaussian, Ggx, Ndf, Phong};
+use facette_bsdf::microfacet::{Beckmann, BeckmannG1, Distribution, Gaussian, Ggx, Ndf, Phong};
 use facette_bsdf::{Vec2, Vec3};
 
 fn inputs() -> (Vec<Vec3>, Vec<Vec2>) {
@@ -21,59 +23,45 @@ fn inputs() -> (Vec<Vec3>, Vec<Vec2>) {
     (dirs, us)
 }
 
+/// Times `f` over the 256 inputs.
+fn batch(
+    g: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>,
+    name: &str,
+    dirs: &[Vec3],
+    us: &[Vec2],
+    f: impl Fn(Vec3, Vec3, Vec2) -> f64,
+) {
+    g.bench_function(name, |b| {
+        b.iter(|| {
+            let (dirs, us) = (black_box(dirs), black_box(us));
+            let mut acc = 0.0;
+            for k in 0..256 {
+                acc += f(dirs[k], dirs[255 - k], us[k]);
+            }
+            black_box(acc)
+        })
+    });
+}
+
 fn bench_distribution(c: &mut Criterion, name: &str, d: Ndf) {
     let (dirs, us) = inputs();
     let mut g = c.benchmark_group(name);
-    g.bench_function("D", |b| {
-        let mut k = 0;
-        b.iter(|| {
-            k = (k + 1) & 255;
-            black_box(d.d(black_box(dirs[k])))
-        })
+    g.throughput(Throughput::Elements(256));
+    batch(&mut g, "D", &dirs, &us, |v, _, _| d.d(v));
+    batch(&mut g, "G1", &dirs, &us, |v, _, _| d.g1(v, Vec3::Z));
+    batch(&mut g, "D+G1", &dirs, &us, |v, _, _| {
+        d.d(v) + d.g1(v, Vec3::Z)
     });
-    g.bench_function("G1", |b| {
-        let mut k = 0;
-        b.iter(|| {
-            k = (k + 1) & 255;
-            black_box(d.g1(black_box(dirs[k]), Vec3::Z))
-        })
+    batch(&mut g, "sample_normal", &dirs, &us, |_, _, u| {
+        d.sample_normal(u).z
     });
-    g.bench_function("D+G1", |b| {
-        let mut k = 0;
-        b.iter(|| {
-            k = (k + 1) & 255;
-            let v = black_box(dirs[k]);
-            black_box(d.d(v) + d.g1(v, Vec3::Z))
-        })
-    });
-    g.bench_function("sample_normal", |b| {
-        let mut k = 0;
-        b.iter(|| {
-            k = (k + 1) & 255;
-            black_box(d.sample_normal(black_box(us[k])))
-        })
-    });
-    g.bench_function("pdf_normal", |b| {
-        let mut k = 0;
-        b.iter(|| {
-            k = (k + 1) & 255;
-            black_box(d.pdf_normal(black_box(dirs[k])))
-        })
-    });
+    batch(&mut g, "pdf_normal", &dirs, &us, |v, _, _| d.pdf_normal(v));
     if d.has_visible_sampling() {
-        g.bench_function("sample_visible", |b| {
-            let mut k = 0;
-            b.iter(|| {
-                k = (k + 1) & 255;
-                black_box(d.sample_visible(black_box(dirs[k]), black_box(us[k])))
-            })
+        batch(&mut g, "sample_visible", &dirs, &us, |v, _, u| {
+            d.sample_visible(v, u).z
         });
-        g.bench_function("pdf_visible", |b| {
-            let mut k = 0;
-            b.iter(|| {
-                k = (k + 1) & 255;
-                black_box(d.pdf_visible(black_box(dirs[k]), black_box(dirs[255 - k])))
-            })
+        batch(&mut g, "pdf_visible", &dirs, &us, |v, m, _| {
+            d.pdf_visible(v, m)
         });
     }
     g.finish();
@@ -91,7 +79,7 @@ fn distributions(c: &mut Criterion) {
         Ndf::Beckmann(
             Beckmann::new(0.3, 0.5)
                 .unwrap()
-                .with_g1(facette_bsdf::microfacet::BeckmannG1::Rational),
+                .with_g1(BeckmannG1::Rational),
         ),
     );
     bench_distribution(c, "ggx", Ndf::Ggx(Ggx::new(0.3, 0.5).unwrap()));

@@ -29,6 +29,7 @@ pub mod error;
 pub mod fresnel;
 pub mod math;
 pub mod microfacet;
+pub mod models;
 pub mod spec;
 
 pub mod validation;

@@ -5,6 +5,7 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use facette_bsdf::spec::microfacet::{parse_distribution, MICROFACET_KEYS};
 use facette_bsdf::spec::{parse_inline_table, Params};
+use facette_bsdf::validation::bsdf_checks::{check_bsdf, BsdfCheckOptions};
 use facette_bsdf::validation::chi2::Chi2Config;
 use facette_bsdf::validation::distribution_checks::{check_distribution, DistributionCheckOptions};
 use facette_bsdf::validation::suites::{core_suite, Family, SuiteOptions};
@@ -21,6 +22,9 @@ pub enum FamilyArg {
 
 #[derive(Args)]
 pub struct ValidateArgs {
+    /// A material as a TOML inline table: runs every BSDF check on it.
+    #[arg(long, value_name = "TOML", conflicts_with_all = ["distribution", "family"])]
+    material: Option<String>,
     /// One distribution as a TOML inline table, e.g. '{distribution = "ggx", alpha_u = 0.05, alpha_v = 0.5}'.
     #[arg(long, value_name = "TOML")]
     distribution: Option<String>,
@@ -42,7 +46,20 @@ pub fn run(a: ValidateArgs) -> Result<ExitCode> {
     if a.samples < 1000 {
         anyhow::bail!("--samples must be at least 1000 (got {})", a.samples);
     }
-    let report = if let Some(text) = &a.distribution {
+    let report = if let Some(text) = &a.material {
+        let bsdf = crate::material_arg::parse_material(text)?;
+        let opts = BsdfCheckOptions {
+            chi2: Chi2Config {
+                samples: a.samples,
+                seed: a.seed,
+                ..Chi2Config::default()
+            },
+            ..BsdfCheckOptions::default()
+        };
+        let mut r = Report::new();
+        r.extend(check_bsdf(bsdf.as_ref(), &opts));
+        r
+    } else if let Some(text) = &a.distribution {
         let table = parse_inline_table(text).context("--distribution")?;
         let p = Params::new(&table, "distribution");
         let ndf = parse_distribution(&p, false).context("--distribution")?;

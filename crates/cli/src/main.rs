@@ -1,7 +1,10 @@
 //! `facette`: the command-line front of the library, renderer and lab. Argument parsing and
 //! progress reporting only; each subcommand is a thin call into a crate.
 
+mod cmd_albedo;
+mod cmd_eval;
 mod cmd_validate;
+mod material_arg;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -22,6 +25,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Evaluate a material on directions read as CSV (theta_i,phi_i,theta_o,phi_o in degrees).
+    Eval(cmd_eval::EvalArgs),
+    /// Directional reflectance and transmittance of a material, with standard errors.
+    Albedo(cmd_albedo::AlbedoArgs),
     /// Statistical validation: the microfacet core suite, one distribution, or a material.
     Validate(cmd_validate::ValidateArgs),
 }
@@ -29,6 +36,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Eval(a) => cmd_eval::run(a),
+        Command::Albedo(a) => cmd_albedo::run(a),
         Command::Validate(a) => cmd_validate::run(a),
     };
     match result {

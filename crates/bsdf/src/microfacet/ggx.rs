@@ -17,16 +17,31 @@ use crate::math::{fmt_num, Vec2, Vec3, PI, TWO_PI};
 pub struct Ggx {
     ax: f64,
     ay: f64,
+    // Precomputed so that D and G1 cost one division each.
+    ax2: f64,
+    ay2: f64,
+    inv_ax2: f64,
+    inv_ay2: f64,
+    norm: f64,
 }
 
 impl Ggx {
     pub fn new(alpha_x: f64, alpha_y: f64) -> ParamResult<Self> {
         check_range("alpha_u", alpha_x, 0.0, 10.0, Bounds::OpenClosed)?;
         check_range("alpha_v", alpha_y, 0.0, 10.0, Bounds::OpenClosed)?;
-        Ok(Ggx {
-            ax: alpha_x,
-            ay: alpha_y,
-        })
+        Ok(Self::from_alphas(alpha_x, alpha_y))
+    }
+
+    fn from_alphas(ax: f64, ay: f64) -> Self {
+        Ggx {
+            ax,
+            ay,
+            ax2: ax * ax,
+            ay2: ay * ay,
+            inv_ax2: 1.0 / (ax * ax),
+            inv_ay2: 1.0 / (ay * ay),
+            norm: 1.0 / (PI * ax * ay),
+        }
     }
 
     pub fn isotropic(alpha: f64) -> ParamResult<Self> {
@@ -36,10 +51,7 @@ impl Ggx {
 
     /// Isotropic GGX without validation, for internal proposals (width must be > 0).
     pub(crate) fn isotropic_unchecked(alpha: f64) -> Self {
-        Ggx {
-            ax: alpha,
-            ay: alpha,
-        }
+        Self::from_alphas(alpha, alpha)
     }
 
     pub fn alpha_x(&self) -> f64 {
@@ -51,10 +63,7 @@ impl Ggx {
     }
 
     pub fn scaled(&self, s: f64) -> Self {
-        Ggx {
-            ax: self.ax * s,
-            ay: self.ay * s,
-        }
+        Self::from_alphas(self.ax * s, self.ay * s)
     }
 }
 
@@ -67,21 +76,33 @@ impl Distribution for Ggx {
             return 0.0;
         }
         // Written as 1/(π α_x α_y (x²/α_x² + y²/α_y² + z²)²), finite up to the horizon.
-        let t = m.x * m.x / (self.ax * self.ax) + m.y * m.y / (self.ay * self.ay) + m.z * m.z;
-        1.0 / (PI * self.ax * self.ay * t * t)
+        let t = m.x * m.x * self.inv_ax2 + m.y * m.y * self.inv_ay2 + m.z * m.z;
+        self.norm / (t * t)
     }
 
-    /// Λ(v) = (−1 + √(1 + α_v² tan² θ_v)) / 2  [IL18 eq. 22; WMLT07 eq. 34].
+    /// Λ(v) = (−1 + √(1 + α_v² tan² θ_v)) / 2  [IL18 eq. 22; WMLT07 eq. 34], written as
+    /// s²/(2z(r + z)) with z = |cos θ|, s² = α_v² sin² θ, r = √(z² + s²): no cancellation
+    /// for small slopes.
     #[inline]
     fn lambda(&self, v: Vec3) -> f64 {
-        let s2 = self.ax * self.ax * v.x * v.x + self.ay * self.ay * v.y * v.y;
-        let z2 = v.z * v.z;
-        if z2 == 0.0 {
+        let s2 = self.ax2 * v.x * v.x + self.ay2 * v.y * v.y;
+        let z = v.z.abs();
+        if z == 0.0 {
             return if s2 > 0.0 { f64::INFINITY } else { 0.0 };
         }
-        let t = s2 / z2; // α_v² tan² θ_v
-                         // (√(1+t) − 1)/2 = t / (2(√(1+t) + 1)): no cancellation for small t.
-        t / (2.0 * ((1.0 + t).sqrt() + 1.0))
+        let r = (z * z + s2).sqrt();
+        s2 / (2.0 * z * (r + z))
+    }
+
+    /// G1 = 2z / (z + √(z² + α_v² sin² θ))  [WMLT07 eq. 34]: one square root, one division.
+    #[inline]
+    fn g1(&self, v: Vec3, m: Vec3) -> f64 {
+        if v.dot(m) * v.z <= 0.0 {
+            return 0.0;
+        }
+        let s2 = self.ax2 * v.x * v.x + self.ay2 * v.y * v.y;
+        let z = v.z.abs();
+        2.0 * z / (z + (z * z + s2).sqrt())
     }
 
     /// Samples D(m)|m·n|: unit slope radius r = √(ξ1/(1−ξ1)) at angle 2πξ2, stretched by

@@ -2,9 +2,11 @@
 //! line (`--material '{type = "dielectric", alpha = 0.3}'`) and the scene files. Every key
 //! is validated; unknown keys and values are errors that list the valid ones.
 
+pub mod material;
 pub mod microfacet;
 pub mod params;
 
+pub use material::{build_material, MATERIAL_TYPES};
 pub use params::Params;
 
 use crate::error::ParamError;

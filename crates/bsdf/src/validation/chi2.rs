@@ -41,7 +41,7 @@ pub struct Chi2Outcome {
     pub p_value: f64,
     /// ∫ pdf over the sphere (≤ 1; < 1 when the sampler can fail or has delta lobes).
     pub pdf_integral: f64,
-    /// Fraction of draws that returned no direction.
+    /// Fraction of draws that returned no direction or one outside the tested region.
     pub null_fraction: f64,
     /// Draws that landed where pdf = 0 (must be zero).
     pub zero_pdf_hits: usize,
@@ -61,7 +61,7 @@ impl Chi2Outcome {
             self.statistic, self.dof, self.p_value, self.pdf_integral
         );
         if self.null_fraction > 0.0 {
-            s += &format!(", no-sample {:.4}", self.null_fraction);
+            s += &format!(", outside/no-sample {:.4}", self.null_fraction);
         }
         if self.zero_pdf_hits > 0 {
             s += &format!(", {} samples where pdf = 0", self.zero_pdf_hits);
@@ -81,6 +81,22 @@ pub fn chi2_test(
     sample: impl Fn(&mut Pcg32) -> Option<Vec3> + Sync,
     pdf: impl Fn(Vec3) -> f64 + Sync,
 ) -> Chi2Outcome {
+    chi2_test_region(map, cfg, |_| true, sample, pdf)
+}
+
+/// [`chi2_test`] restricted to a region of the sphere: directions outside `in_region` (and
+/// draws without a direction) all fall in one cell whose expected probability is
+/// 1 − ∫_region pdf. A lobe outside the region is then tested only through its total mass,
+/// and needs no resolution from this map — the way a dielectric's reflection and
+/// transmission lobes are tested each with a map zoomed on it.
+pub fn chi2_test_region(
+    map: &SphereMap,
+    cfg: &Chi2Config,
+    in_region: impl Fn(Vec3) -> bool + Sync,
+    sample: impl Fn(&mut Pcg32) -> Option<Vec3> + Sync,
+    pdf: impl Fn(Vec3) -> f64 + Sync,
+) -> Chi2Outcome {
+    let pdf = |d: Vec3| if in_region(d) { pdf(d) } else { 0.0 };
     let (nu, nv) = cfg.bins;
     let cells = nu * nv;
     const CHUNKS: usize = 64;
@@ -100,6 +116,10 @@ pub fn chi2_test(
                     Some(d) => {
                         if !d.is_finite() || (d.length_squared() - 1.0).abs() > 1e-6 {
                             invalid += 1;
+                            continue;
+                        }
+                        if !in_region(d) {
+                            null += 1;
                             continue;
                         }
                         if !(pdf(d) > 0.0) {

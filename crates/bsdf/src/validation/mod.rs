@@ -5,12 +5,14 @@
 //! corrected for the number of chi-square tests (Šidák), so adding tests does not inflate
 //! the false-failure rate. Seeds are fixed: a report is reproducible bit for bit.
 
+pub mod bsdf_checks;
 pub mod chi2;
 pub mod distribution_checks;
+pub mod measurements;
 pub mod sphere_map;
 pub mod suites;
 
-pub use chi2::{chi2_test, corrected_significance, Chi2Config, Chi2Outcome};
+pub use chi2::{chi2_test, chi2_test_region, corrected_significance, Chi2Config, Chi2Outcome};
 pub use sphere_map::SphereMap;
 
 /// How a check is judged.

@@ -302,3 +302,69 @@ pub fn core_suite(opts: &SuiteOptions, only: Option<Family>) -> Report {
     }
     r
 }
+
+/// The material grid of the reference-BSDF suite: every model, rough and near-smooth,
+/// isotropic and anisotropic, every distribution and masking where the model allows it.
+pub fn material_grid() -> Vec<&'static str> {
+    vec![
+        r#"{type = "lambert", reflectance = [0.2, 0.5, 0.9]}"#,
+        r#"{type = "oren-nayar", sigma = 0.1, reflectance = 0.8}"#,
+        r#"{type = "oren-nayar", sigma = 0.5, evaluation = "stochastic"}"#,
+        r#"{type = "oren-nayar", sigma = 1.0, samples = 64}"#,
+        r#"{type = "oren-nayar", sigma = 0.3, model = "qualitative"}"#,
+        r#"{type = "oren-nayar", sigma = 1.0, model = "qualitative", reflectance = 1.0}"#,
+        r#"{type = "conductor", distribution = "beckmann", alpha = 0.02, material = "Au"}"#,
+        r#"{type = "conductor", distribution = "beckmann", alpha = 0.3}"#,
+        r#"{type = "conductor", distribution = "beckmann", alpha = 1.0, sampling = "distribution"}"#,
+        r#"{type = "conductor", distribution = "ggx", alpha = 0.02}"#,
+        r#"{type = "conductor", distribution = "ggx", alpha = 0.1, material = "Cu"}"#,
+        r#"{type = "conductor", distribution = "ggx", alpha = 1.0, masking = "smith-correlated"}"#,
+        r#"{type = "conductor", distribution = "ggx", alpha_u = 0.05, alpha_v = 0.4, material = "Al"}"#,
+        r#"{type = "conductor", distribution = "beckmann", alpha_u = 0.4, alpha_v = 0.05, sampling = "distribution"}"#,
+        r#"{type = "conductor", distribution = "beckmann", alpha = 0.3, masking = "v-cavity"}"#,
+        r#"{type = "conductor", distribution = "beckmann", alpha = 0.3, masking = "kelemen", g1 = "rational"}"#,
+        r#"{type = "conductor", distribution = "gaussian", sigma = 0.3}"#,
+        r#"{type = "conductor", distribution = "phong", exponent = 100, material = "Ag"}"#,
+        r#"{type = "conductor", distribution = "phong", exponent = 10, g1 = "numeric"}"#,
+        r#"{type = "conductor", alpha = 0, material = "Cr"}"#,
+        r#"{type = "dielectric", distribution = "beckmann", alpha = 0.02}"#,
+        r#"{type = "dielectric", distribution = "beckmann", alpha = 0.3, sampling = "distribution"}"#,
+        r#"{type = "dielectric", distribution = "beckmann", alpha = 0.3, sampling = "widened"}"#,
+        r#"{type = "dielectric", distribution = "beckmann", alpha = 1.0}"#,
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.02, ior = 1.33}"#,
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.1}"#,
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.3, masking = "smith-correlated"}"#,
+        r#"{type = "dielectric", distribution = "ggx", alpha = 1.0, sampling = "distribution"}"#,
+        r#"{type = "dielectric", distribution = "ggx", alpha_u = 0.05, alpha_v = 0.4}"#,
+        r#"{type = "dielectric", preset = "ground", distribution = "ggx"}"#,
+        r#"{type = "dielectric", alpha = 0, ior = 1.5}"#,
+        r#"{type = "kelemen", distribution = "ward", alpha = 0.05, kd = 0.7, table_samples = 4096}"#,
+        r#"{type = "kelemen", distribution = "ward", alpha = 0.8, kd = [0.9, 0.5, 0.2], table_samples = 4096}"#,
+        r#"{type = "kelemen", distribution = "beckmann", alpha = 0.3, table_samples = 4096}"#,
+        r#"{type = "kelemen", distribution = "phong", exponent = 40, ior = 1.7, table_samples = 4096}"#,
+    ]
+}
+
+/// Checks of every material of [`material_grid`] whose TOML contains `filter` (all when
+/// `None`).
+pub fn material_suite(opts: &SuiteOptions, filter: Option<&str>) -> Report {
+    use super::bsdf_checks::{check_bsdf, BsdfCheckOptions};
+    let bopts = BsdfCheckOptions {
+        chi2: Chi2Config {
+            samples: opts.chi2_samples,
+            seed: opts.seed,
+            ..Chi2Config::default()
+        },
+        ..BsdfCheckOptions::default()
+    };
+    let mut r = Report::new();
+    for m in material_grid() {
+        if filter.is_some_and(|f| !m.contains(f)) {
+            continue;
+        }
+        let table = crate::spec::parse_inline_table(m).expect("grid entries parse");
+        let bsdf = crate::spec::build_material(&table).expect("grid entries build");
+        r.extend(check_bsdf(bsdf.as_ref(), &bopts));
+    }
+    r
+}

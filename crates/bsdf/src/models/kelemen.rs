@@ -1,0 +1,388 @@
+//! The coupled specular-matte BRDF of KSK01.
+//!
+//! - Specular: f_s(L, V) = P_H(H) F(H·L) / (2 (1 + L·V)) = P_H(H) F / (4 cos²β)  [KSK01 eq. 3],
+//!   with Ward, Beckmann or Phong half-vector densities (see
+//!   [`crate::microfacet::half_vector_density`]).
+//! - Matte: f_m(L, V) = k (1 − a_s(θ')) (1 − a_s(θ)) / (π (1 − ā_s))  [KSK01 §2.2], where
+//!   a_s(θ) = ∫ f_s cos θ dω is the specular albedo and ā_s = (1/π) ∫ a_s(θ) cos θ dω its
+//!   average. With k = 1 the total albedo is exactly 1 at every angle [KSK01 eq. 7].
+//!
+//! a_s(θ) is tabulated when the material is built (91 angles, 0°…90°, linear interpolation),
+//! each entry by the Monte Carlo quadrature of KSK01 §2.1.5 with the specular sampler —
+//! randomized QMC with `table_samples` points in 8 rotations, whose standard error is kept
+//! (`albedo_table_stderr`). ā_s integrates the interpolated table exactly.
+//!
+//! Sampling (KSK01 §2.1.4, §2.2.1): the specular lobe through H and reflection; the matte
+//! lobe by the inverse cumulative table of (1 − a_s(θ)) cos θ. KSK01 writes the cumulative as
+//! I(θ') = ∫_0^θ' (1 − a_s(ξ)) cos ξ dξ, which omits the sin ξ of the solid-angle measure; the
+//! density proportional to (1 − a_s(θ')) cos θ' needs ∫ (1 − a_s) cos ξ sin ξ dξ, used here.
+//! Lobes are chosen with probabilities proportional to KSK01's a_s(θ) and k̃ (1 − a_s(θ)); the
+//! third outcome of KSK01's Russian roulette, termination with probability
+//! (1 − k̃)(1 − a_s(θ)), is left to the integrator: [`Kelemen::lobe_probabilities`] exposes
+//! the three, and `sample` returns weights for the two scattering lobes only.
+//!
+//! | key | meaning | range | default |
+//! |---|---|---|---|
+//! | `distribution` | `ward`, `beckmann` or `phong` half-vector density | — | `ward` |
+//! | `alpha` | RMS slope m (ward, beckmann) | (0, 10] | required |
+//! | `exponent` | Phong exponent n | [0, 1e7] | required for phong |
+//! | `ior` | index of the Fresnel term (dielectric) | > 1 | 1.5 |
+//! | `kd` | matte colour k (number or RGB) | [0, 1] | 0.5 |
+//! | `table_samples` | QMC samples per albedo-table entry | ≥ 64 | 16384 |
+
+use super::{flip, to_upper_pair};
+use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::fresnel::Fresnel;
+use crate::math::quadrature::GaussLegendre;
+use crate::math::rng::{Pcg32, RandomSource};
+use crate::math::spectrum::Spectrum;
+use crate::math::warp::hammersley;
+use crate::math::{reflect, Vec3, PI, TWO_PI};
+use crate::microfacet::half_vector_density::HalfVectorDensity;
+use crate::spec::params::check_spectrum;
+
+/// Number of intervals of the albedo table over [0, π/2].
+const TABLE_INTERVALS: usize = 90;
+
+#[derive(Clone, Debug)]
+pub struct Kelemen {
+    density: HalfVectorDensity,
+    fresnel: Fresnel,
+    kd: Spectrum,
+    /// a_s(θ_k), θ_k = k·(π/2)/TABLE_INTERVALS, clamped to [0, 1].
+    albedo: Vec<Spectrum>,
+    albedo_stderr: f64,
+    average: Spectrum,
+    /// Cumulative of the matte sampling density in θ (piecewise linear g(θ) =
+    /// (1 − ā_s(θ)) cos θ sin θ on the table grid).
+    matte_cdf: Vec<f64>,
+    matte_g: Vec<f64>,
+}
+
+impl Kelemen {
+    pub fn new(
+        density: HalfVectorDensity,
+        fresnel: Fresnel,
+        kd: Spectrum,
+        table_samples: usize,
+    ) -> ParamResult<Self> {
+        check_spectrum("kd", kd, 0.0, 1.0)?;
+        if table_samples < 64 {
+            return Err(ParamError::OutOfRange {
+                name: "table_samples".into(),
+                value: table_samples as f64,
+                expected: "table_samples >= 64".into(),
+            });
+        }
+        let mut k = Kelemen {
+            density,
+            fresnel,
+            kd,
+            albedo: Vec::new(),
+            albedo_stderr: 0.0,
+            average: Spectrum::ZERO,
+            matte_cdf: Vec::new(),
+            matte_g: Vec::new(),
+        };
+        k.build_tables(table_samples);
+        Ok(k)
+    }
+
+    /// Builds a_s(θ) [KSK01 §2.1.5], its average and the matte sampling table.
+    fn build_tables(&mut self, samples: usize) {
+        use rayon::prelude::*;
+        const ROT: usize = 8;
+        let per = (samples / ROT).max(8) as u32;
+        let step = 0.5 * PI / TABLE_INTERVALS as f64;
+        let rows: Vec<(Spectrum, f64)> = (0..=TABLE_INTERVALS)
+            .into_par_iter()
+            .map(|k| {
+                let theta = (k as f64 * step).min(0.5 * PI - 1e-6);
+                let w = Vec3::new(theta.sin(), 0.0, theta.cos());
+                let mut rng = Pcg32::new(0x00a1_bed0, k as u64);
+                let mut means = [Spectrum::ZERO; ROT];
+                for mean in means.iter_mut() {
+                    let shift = rng.next_2d();
+                    let mut s = Spectrum::ZERO;
+                    for j in 0..per {
+                        if let Some((_, weight)) =
+                            self.sample_specular(w, hammersley(j, per, shift))
+                        {
+                            s += weight;
+                        }
+                    }
+                    *mean = s / per as f64;
+                }
+                let mean = means.iter().fold(Spectrum::ZERO, |a, &b| a + b) / ROT as f64;
+                let var = means
+                    .iter()
+                    .map(|m| (*m - mean).average().powi(2))
+                    .sum::<f64>()
+                    / (ROT as f64 - 1.0);
+                (mean, (var / ROT as f64).sqrt())
+            })
+            .collect();
+        self.albedo = rows
+            .iter()
+            .map(|r| r.0.map(|v| v.clamp(0.0, 1.0)))
+            .collect();
+        self.albedo_stderr = rows.iter().map(|r| r.1).fold(0.0, f64::max);
+        // ā_s = 2 ∫ a_s(θ) cos θ sin θ dθ of the interpolated table, segment by segment.
+        let gl = GaussLegendre::new(8);
+        let mut avg = Spectrum::ZERO;
+        for seg in 0..TABLE_INTERVALS {
+            let (t0, t1) = (seg as f64 * step, (seg + 1) as f64 * step);
+            for c in 0..crate::math::spectrum::CHANNELS {
+                avg[c] += 2.0 * gl.integrate(t0, t1, |t| self.albedo_at(t)[c] * t.cos() * t.sin());
+            }
+        }
+        self.average = avg;
+        // Matte sampling: g(θ) = (1 − ā_s(θ)) cos θ sin θ, piecewise linear on the grid.
+        self.matte_g = (0..=TABLE_INTERVALS)
+            .map(|k| {
+                let t = k as f64 * step;
+                (1.0 - self.albedo[k].average()).max(0.0) * t.cos() * t.sin()
+            })
+            .collect();
+        let mut cdf = vec![0.0; TABLE_INTERVALS + 1];
+        for k in 0..TABLE_INTERVALS {
+            cdf[k + 1] = cdf[k] + 0.5 * (self.matte_g[k] + self.matte_g[k + 1]) * step;
+        }
+        self.matte_cdf = cdf;
+    }
+
+    /// Interpolated a_s(θ).
+    pub fn albedo_at(&self, theta: f64) -> Spectrum {
+        let x = (theta / (0.5 * PI) * TABLE_INTERVALS as f64).clamp(0.0, TABLE_INTERVALS as f64);
+        let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
+        let t = x - k as f64;
+        self.albedo[k] * (1.0 - t) + self.albedo[k + 1] * t
+    }
+
+    /// The average specular albedo ā_s.
+    pub fn average_albedo(&self) -> Spectrum {
+        self.average
+    }
+
+    /// Largest standard error of the a_s table entries.
+    pub fn albedo_table_stderr(&self) -> f64 {
+        self.albedo_stderr
+    }
+
+    /// KSK01 §2.2.1's Russian-roulette probabilities for a path arriving along `wo`:
+    /// (specular a_s, matte k̃ (1 − a_s), terminate (1 − k̃)(1 − a_s)).
+    pub fn lobe_probabilities(&self, wo: Vec3) -> (f64, f64, f64) {
+        let a = self.albedo_at(wo.z.abs().min(1.0).acos()).average();
+        let k = self.kd.average();
+        (a, k * (1.0 - a), (1.0 - k) * (1.0 - a))
+    }
+
+    /// Probability with which `sample` picks the specular lobe (the first two outcomes of
+    /// `lobe_probabilities`, renormalized).
+    fn specular_choice(&self, wo: Vec3) -> f64 {
+        let (s, m, _) = self.lobe_probabilities(wo);
+        if s + m <= 0.0 {
+            1.0
+        } else {
+            s / (s + m)
+        }
+    }
+
+    /// KSK01 eq. 3.
+    #[inline]
+    fn specular(&self, o: Vec3, i: Vec3) -> Spectrum {
+        let hv = o + i;
+        let hh = hv.length_squared();
+        if hh <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let h = hv / hh.sqrt();
+        let p = self.density.density(h);
+        if p == 0.0 {
+            return Spectrum::ZERO;
+        }
+        // 2 (1 + L·V) = |L + V|².
+        self.fresnel.eval(o.dot(h)) * (p / hh)
+    }
+
+    /// KSK01 §2.2.
+    #[inline]
+    fn matte(&self, o: Vec3, i: Vec3) -> Spectrum {
+        let ao = self.albedo_at(o.z.min(1.0).acos());
+        let ai = self.albedo_at(i.z.min(1.0).acos());
+        let denom = Spectrum::ONE - self.average;
+        let num = (Spectrum::ONE - ao) * (Spectrum::ONE - ai);
+        self.kd * num.zip(denom, |n, d| if d > 0.0 { n / d } else { 0.0 }) / PI
+    }
+
+    /// Specular sample from `o` (upper hemisphere): (wi, weight f_s cos/pdf_s).
+    fn sample_specular(&self, o: Vec3, u: crate::math::Vec2) -> Option<(Vec3, Spectrum)> {
+        let h = self.density.sample(u);
+        let c = o.dot(h);
+        if c <= 0.0 {
+            return None;
+        }
+        let i = reflect(o, h);
+        if i.z <= 0.0 {
+            return None;
+        }
+        let ps = self.density.sample_pdf(h);
+        if !(ps > 0.0) {
+            return None;
+        }
+        // f_s cos θ_i / (p_s / (4 c)) = P_H F cos θ_i / (c p_s)   [KSK01 §2.1.5].
+        Some((
+            i,
+            self.fresnel.eval(c) * (self.density.density(h) * i.z / (c * ps)),
+        ))
+    }
+
+    fn pdf_specular(&self, o: Vec3, i: Vec3) -> f64 {
+        let h = (o + i).normalize_or_zero();
+        let c = o.dot(h);
+        if h.z <= 0.0 || c <= 0.0 {
+            return 0.0;
+        }
+        self.density.sample_pdf(h) / (4.0 * c)
+    }
+
+    fn pdf_matte(&self, i: Vec3) -> f64 {
+        let theta = i.z.min(1.0).acos();
+        let step = 0.5 * PI / TABLE_INTERVALS as f64;
+        let x = (theta / step).clamp(0.0, TABLE_INTERVALS as f64);
+        let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
+        let t = x - k as f64;
+        let g = self.matte_g[k] * (1.0 - t) + self.matte_g[k + 1] * t;
+        let total = self.matte_cdf[TABLE_INTERVALS];
+        let s = theta.sin();
+        if total <= 0.0 || s <= 0.0 {
+            // θ = 0 has measure zero; return the density's limit along the axis.
+            return if total > 0.0 {
+                (1.0 - self.albedo[0].average()) / (TWO_PI * total)
+            } else {
+                0.0
+            };
+        }
+        g / (TWO_PI * s * total)
+    }
+
+    fn sample_matte(&self, u: crate::math::Vec2) -> Option<Vec3> {
+        let total = self.matte_cdf[TABLE_INTERVALS];
+        if total <= 0.0 {
+            return None;
+        }
+        let target = u.x * total;
+        let k = match self.matte_cdf.binary_search_by(|c| c.total_cmp(&target)) {
+            Ok(k) => k.min(TABLE_INTERVALS - 1),
+            Err(k) => k.saturating_sub(1).min(TABLE_INTERVALS - 1),
+        };
+        let step = 0.5 * PI / TABLE_INTERVALS as f64;
+        // Invert the quadratic cumulative of the linear g on [θ_k, θ_k+1].
+        let (g0, g1) = (self.matte_g[k], self.matte_g[k + 1]);
+        let r = target - self.matte_cdf[k];
+        let slope = (g1 - g0) / step;
+        let dt = if slope.abs() < 1e-14 {
+            if g0 > 0.0 {
+                r / g0
+            } else {
+                0.0
+            }
+        } else {
+            let disc = (g0 * g0 + 2.0 * slope * r).max(0.0);
+            (disc.sqrt() - g0) / slope
+        };
+        let theta = (k as f64 * step + dt.clamp(0.0, step)).min(0.5 * PI);
+        let phi = TWO_PI * u.y;
+        let i = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        (i.z > 0.0).then_some(i)
+    }
+}
+
+impl Bsdf for Kelemen {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::GLOSSY_REFLECTION | LobeFlags::DIFFUSE_REFLECTION
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
+        match to_upper_pair(wo, wi) {
+            Some((o, i)) => self.specular(o, i) + self.matte(o, i),
+            None => Spectrum::ZERO,
+        }
+    }
+
+    fn sample(
+        &self,
+        wo: Vec3,
+        ctx: &BsdfContext,
+        rng: &mut dyn RandomSource,
+    ) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let below = wo.z < 0.0;
+        let o = if below { flip(wo) } else { wo };
+        let ps = self.specular_choice(o);
+        let (i, lobe) = if rng.next_f64() < ps {
+            (
+                self.sample_specular(o, rng.next_2d())?.0,
+                LobeFlags::GLOSSY_REFLECTION,
+            )
+        } else {
+            (
+                self.sample_matte(rng.next_2d())?,
+                LobeFlags::DIFFUSE_REFLECTION,
+            )
+        };
+        let pdf = self.pdf(o, i, ctx);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        let f = self.specular(o, i) + self.matte(o, i);
+        Some(BsdfSample {
+            wi: if below { flip(i) } else { i },
+            weight: f * (i.z / pdf),
+            pdf,
+            lobe,
+            eta: 1.0,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        match to_upper_pair(wo, wi) {
+            Some((o, i)) => {
+                let ps = self.specular_choice(o);
+                ps * self.pdf_specular(o, i) + (1.0 - ps) * self.pdf_matte(i)
+            }
+            None => 0.0,
+        }
+    }
+
+    fn lobe_width(&self) -> f64 {
+        self.density.typical_width()
+    }
+
+    fn describe(&self) -> String {
+        let r = match self.density {
+            HalfVectorDensity::Ward { m } | HalfVectorDensity::Beckmann { m } => {
+                format!("alpha={}", crate::math::fmt_num(m))
+            }
+            HalfVectorDensity::Phong { n } => format!("exponent={}", crate::math::fmt_num(n)),
+        };
+        format!(
+            "kelemen({} {r}, kd={:?}, {:?})",
+            self.density.name(),
+            self.kd.0,
+            self.fresnel
+        )
+    }
+}
+
+/// Validates a Kelemen Fresnel index.
+pub fn check_ior(ior: f64) -> ParamResult<f64> {
+    check_range("ior", ior, 1.0, 100.0, Bounds::OpenClosed)
+}

@@ -1,0 +1,71 @@
+//! The Lambertian BRDF f = R/π, sampled cosine-weighted. Two-sided.
+//!
+//! | key | meaning | range | default |
+//! |---|---|---|---|
+//! | `reflectance` | albedo R (number or RGB) | [0, 1] | 0.5 |
+
+use super::{flip, to_upper_pair};
+use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::error::ParamResult;
+use crate::math::rng::RandomSource;
+use crate::math::spectrum::Spectrum;
+use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
+use crate::math::{Vec3, INV_PI};
+use crate::spec::params::check_spectrum;
+
+#[derive(Clone, Debug)]
+pub struct Lambert {
+    reflectance: Spectrum,
+}
+
+impl Lambert {
+    pub fn new(reflectance: Spectrum) -> ParamResult<Self> {
+        Ok(Lambert {
+            reflectance: check_spectrum("reflectance", reflectance, 0.0, 1.0)?,
+        })
+    }
+}
+
+impl Bsdf for Lambert {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::DIFFUSE_REFLECTION
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
+        match to_upper_pair(wo, wi) {
+            Some(_) => self.reflectance * INV_PI,
+            None => Spectrum::ZERO,
+        }
+    }
+
+    fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let mut wi = square_to_cosine_hemisphere(rng.next_2d());
+        if wi.z <= 0.0 {
+            return None;
+        }
+        if wo.z < 0.0 {
+            wi = flip(wi);
+        }
+        Some(BsdfSample {
+            wi,
+            weight: self.reflectance,
+            pdf: cosine_hemisphere_pdf(Vec3::new(wi.x, wi.y, wi.z.abs())),
+            lobe: LobeFlags::DIFFUSE_REFLECTION,
+            eta: 1.0,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        match to_upper_pair(wo, wi) {
+            Some((_, wi)) => cosine_hemisphere_pdf(wi),
+            None => 0.0,
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!("lambert(reflectance={:?})", self.reflectance.0)
+    }
+}

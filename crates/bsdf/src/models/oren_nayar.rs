@@ -1,0 +1,279 @@
+//! Oren–Nayar: rough surfaces of Lambertian microfacets, twice.
+//!
+//! - [`OrenNayarExact`]: the single-scattering microfacet integral of IL18 eq. 3 with
+//!   Lambertian facets (f^μ = K_d/π), the Gaussian distribution of IL18 eq. 14 and the
+//!   V-cavity masking of IL18 eq. 15 — interfaced Lambertian with n_i = 1 (IL18 §3.2,
+//!   TSBRM eq. 27), evaluated by the shared [`MicrofacetIntegral`].
+//! - [`OrenNayarQualitative`]: Oren & Nayar's qualitative model (SIGGRAPH 1994, eq. 30):
+//!   f = ρ/π (A + B max(0, cos(φ_i − φ_o)) sin α tan β), A = 1 − 0.5σ²/(σ² + 0.33),
+//!   B = 0.45σ²/(σ² + 0.09), α = max(θ_i, θ_o), β = min(θ_i, θ_o).
+//!
+//! | key | meaning | range | default |
+//! |---|---|---|---|
+//! | `reflectance` | facet albedo K_d (number or RGB) | [0, 1] | 0.5 |
+//! | `sigma` | Gaussian roughness, radians | (0, π/2) (0 = Lambert) | required |
+//! | `model` | `exact` or `qualitative` | — | `exact` |
+//! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (N microfacets, deterministic) | — | `quadrature` |
+//! | `samples` | exact, quadrature: microfacets per evaluation | ≥ 8 | 256 |
+
+use super::microfacet_integral::MicrofacetIntegral;
+use super::{flip, to_upper_pair};
+use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::math::rng::{Pcg32, RandomSource};
+use crate::math::spectrum::Spectrum;
+use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
+use crate::math::{fmt_num, Vec3, INV_PI, PI};
+use crate::microfacet::{Gaussian, Masking, Ndf};
+use crate::spec::params::check_spectrum;
+
+/// How a model estimates its microfacet integral.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegralEvaluation {
+    /// One microfacet per evaluation: unbiased, noisy, what a path tracer uses.
+    Stochastic,
+    /// A fixed set of N microfacets (randomized QMC frozen at construction): deterministic,
+    /// exactly reciprocal, with a standard error.
+    Quadrature { samples: usize },
+}
+
+impl IntegralEvaluation {
+    pub const NAMES: &'static [&'static str] = &["stochastic", "quadrature"];
+}
+
+/// Cosine-weighted sampling shared by the diffuse-type models: returns (wi, pdf) on the side
+/// of `wo`.
+pub(crate) fn sample_cosine_same_side(wo: Vec3, rng: &mut dyn RandomSource) -> Option<(Vec3, f64)> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    let wi = square_to_cosine_hemisphere(rng.next_2d());
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let pdf = cosine_hemisphere_pdf(wi);
+    Some((if wo.z < 0.0 { flip(wi) } else { wi }, pdf))
+}
+
+#[derive(Clone, Debug)]
+pub struct OrenNayarExact {
+    reflectance: Spectrum,
+    sigma: f64,
+    integral: MicrofacetIntegral,
+    evaluation: IntegralEvaluation,
+}
+
+/// Seed of the frozen quadrature point sets: fixed so that evaluation is deterministic.
+pub(crate) const QUADRATURE_SEED: u64 = 0x005e_ed0f_fac7;
+
+impl OrenNayarExact {
+    pub fn new(
+        reflectance: Spectrum,
+        sigma: f64,
+        evaluation: IntegralEvaluation,
+    ) -> ParamResult<Self> {
+        check_spectrum("reflectance", reflectance, 0.0, 1.0)?;
+        check_range("sigma", sigma, 0.0, 0.5 * PI, Bounds::Open)?;
+        if let IntegralEvaluation::Quadrature { samples } = evaluation {
+            if samples < 8 {
+                return Err(ParamError::OutOfRange {
+                    name: "samples".into(),
+                    value: samples as f64,
+                    expected: "samples >= 8".into(),
+                });
+            }
+        }
+        Ok(OrenNayarExact {
+            reflectance,
+            sigma,
+            integral: MicrofacetIntegral::new(
+                Ndf::Gaussian(Gaussian::new(sigma)?),
+                Masking::VCavity,
+            )?,
+            evaluation,
+        })
+    }
+
+    /// The microfacet integral ∫ D G |im||om|/(|in||on|) dω (without K_d/π) and its
+    /// standard error.
+    fn integral_value(&self, i: Vec3, o: Vec3, rng: &mut dyn RandomSource) -> (f64, f64) {
+        match self.evaluation {
+            IntegralEvaluation::Stochastic => (
+                self.integral.estimate_one(i, o, rng.next_2d(), |_| 1.0),
+                0.0,
+            ),
+            IntegralEvaluation::Quadrature { samples } => {
+                self.integral
+                    .estimate(i, o, samples, &mut Pcg32::new(QUADRATURE_SEED, 0), |_| 1.0)
+            }
+        }
+    }
+}
+
+impl Bsdf for OrenNayarExact {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::DIFFUSE_REFLECTION
+    }
+
+    fn is_stochastic(&self) -> bool {
+        self.evaluation == IntegralEvaluation::Stochastic
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
+        match to_upper_pair(wo, wi) {
+            Some((o, i)) => self.reflectance * (INV_PI * self.integral_value(i, o, rng).0),
+            None => Spectrum::ZERO,
+        }
+    }
+
+    fn eval_estimate(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        ctx: &BsdfContext,
+        samples: usize,
+        rng: &mut dyn RandomSource,
+    ) -> (Spectrum, Spectrum) {
+        let Some((o, i)) = to_upper_pair(wo, wi) else {
+            return (Spectrum::ZERO, Spectrum::ZERO);
+        };
+        let (v, se) = match self.evaluation {
+            IntegralEvaluation::Quadrature { .. } => self.integral_value(i, o, rng),
+            IntegralEvaluation::Stochastic => self.integral.estimate(i, o, samples, rng, |_| 1.0),
+        };
+        let _ = ctx;
+        (
+            self.reflectance * (INV_PI * v),
+            self.reflectance * (INV_PI * se),
+        )
+    }
+
+    fn sample(
+        &self,
+        wo: Vec3,
+        ctx: &BsdfContext,
+        rng: &mut dyn RandomSource,
+    ) -> Option<BsdfSample> {
+        let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
+        let f = self.eval(wo, wi, ctx, rng);
+        Some(BsdfSample {
+            wi,
+            weight: f * (wi.z.abs() / pdf),
+            pdf,
+            lobe: LobeFlags::DIFFUSE_REFLECTION,
+            eta: 1.0,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        match to_upper_pair(wo, wi) {
+            Some((_, wi)) => cosine_hemisphere_pdf(wi),
+            None => 0.0,
+        }
+    }
+
+    fn describe(&self) -> String {
+        let e = match self.evaluation {
+            IntegralEvaluation::Stochastic => "stochastic".to_string(),
+            IntegralEvaluation::Quadrature { samples } => format!("quadrature {samples}"),
+        };
+        format!(
+            "oren-nayar exact(reflectance={:?}, sigma={}, {e})",
+            self.reflectance.0,
+            fmt_num(self.sigma)
+        )
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct OrenNayarQualitative {
+    reflectance: Spectrum,
+    sigma: f64,
+    a: f64,
+    b: f64,
+}
+
+impl OrenNayarQualitative {
+    pub fn new(reflectance: Spectrum, sigma: f64) -> ParamResult<Self> {
+        check_spectrum("reflectance", reflectance, 0.0, 1.0)?;
+        check_range("sigma", sigma, 0.0, 0.5 * PI, Bounds::ClosedOpen)?;
+        let s2 = sigma * sigma;
+        Ok(OrenNayarQualitative {
+            reflectance,
+            sigma,
+            a: 1.0 - 0.5 * s2 / (s2 + 0.33),
+            b: 0.45 * s2 / (s2 + 0.09),
+        })
+    }
+
+    /// The scalar factor A + B max(0, cos Δφ) sin α tan β, for i and o in the upper
+    /// hemisphere.
+    pub fn factor(&self, i: Vec3, o: Vec3) -> f64 {
+        let (si, so) = (
+            (1.0 - i.z * i.z).max(0.0).sqrt(),
+            (1.0 - o.z * o.z).max(0.0).sqrt(),
+        );
+        let cos_dphi = if si > 1e-12 && so > 1e-12 {
+            ((i.x * o.x + i.y * o.y) / (si * so)).clamp(-1.0, 1.0)
+        } else {
+            0.0
+        };
+        // α = max(θ_i, θ_o) has the smaller cosine; β = min(θ_i, θ_o) the larger.
+        let (sin_alpha, sin_beta, cos_beta) = if i.z < o.z {
+            (si, so, o.z)
+        } else {
+            (so, si, i.z)
+        };
+        let tan_beta = if cos_beta > 0.0 {
+            sin_beta / cos_beta
+        } else {
+            0.0
+        };
+        self.a + self.b * cos_dphi.max(0.0) * sin_alpha * tan_beta
+    }
+}
+
+impl Bsdf for OrenNayarQualitative {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::DIFFUSE_REFLECTION
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
+        match to_upper_pair(wo, wi) {
+            Some((o, i)) => self.reflectance * (INV_PI * self.factor(i, o)),
+            None => Spectrum::ZERO,
+        }
+    }
+
+    fn sample(
+        &self,
+        wo: Vec3,
+        ctx: &BsdfContext,
+        rng: &mut dyn RandomSource,
+    ) -> Option<BsdfSample> {
+        let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
+        let f = self.eval(wo, wi, ctx, rng);
+        Some(BsdfSample {
+            wi,
+            weight: f * (wi.z.abs() / pdf),
+            pdf,
+            lobe: LobeFlags::DIFFUSE_REFLECTION,
+            eta: 1.0,
+        })
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        match to_upper_pair(wo, wi) {
+            Some((_, wi)) => cosine_hemisphere_pdf(wi),
+            None => 0.0,
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "oren-nayar qualitative(reflectance={:?}, sigma={})",
+            self.reflectance.0,
+            fmt_num(self.sigma)
+        )
+    }
+}

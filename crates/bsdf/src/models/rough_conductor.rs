@@ -1,0 +1,120 @@
+//! Rough conductor: the Cook–Torrance microfacet BRDF
+//! f = F(i, h) D(h) G(i, o, h) / (4 |i·n| |o·n|)  [WMLT07 eq. 20; IL18 eq. 4] with a conductor
+//! Fresnel term, any distribution and masking of the core; perfectly smooth (a delta
+//! reflection) when α = 0. Two-sided.
+//!
+//! | key | meaning | range | default |
+//! |---|---|---|---|
+//! | microfacet keys | see `docs/materials.md` (`distribution`, `alpha`, …) | | |
+//! | `material` | metal preset (`Au`, `Ag`, `Cu`, `Al`, `Cr`) or `none` (F = 1) | — | `none` |
+//! | `eta`, `k` | complex index per channel (instead of `material`) | η > 0, k ≥ 0 | — |
+//! | `specular_reflectance` | multiplier of the lobe (number or RGB) | [0, 1] | 1 |
+
+use super::{flip, to_upper_pair};
+use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::fresnel::Fresnel;
+use crate::math::rng::RandomSource;
+use crate::math::spectrum::Spectrum;
+use crate::math::Vec3;
+use crate::microfacet::specular_lobe::SpecularLobe;
+use crate::microfacet::Distribution;
+
+#[derive(Clone, Debug)]
+pub struct RoughConductor {
+    /// `None`: perfectly smooth.
+    lobe: Option<SpecularLobe>,
+    fresnel: Fresnel,
+    tint: Spectrum,
+}
+
+impl RoughConductor {
+    pub fn new(lobe: Option<SpecularLobe>, fresnel: Fresnel, tint: Spectrum) -> Self {
+        RoughConductor {
+            lobe,
+            fresnel,
+            tint,
+        }
+    }
+
+    pub fn lobe(&self) -> Option<&SpecularLobe> {
+        self.lobe.as_ref()
+    }
+
+    pub fn fresnel(&self) -> &Fresnel {
+        &self.fresnel
+    }
+}
+
+impl Bsdf for RoughConductor {
+    fn flags(&self) -> LobeFlags {
+        if self.lobe.is_some() {
+            LobeFlags::GLOSSY_REFLECTION
+        } else {
+            LobeFlags::DELTA_REFLECTION
+        }
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
+        let (Some(lobe), Some((o, i))) = (&self.lobe, to_upper_pair(wo, wi)) else {
+            return Spectrum::ZERO;
+        };
+        self.tint * lobe.eval(o, i, |c| self.fresnel.eval(c))
+    }
+
+    fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let below = wo.z < 0.0;
+        let o = if below { flip(wo) } else { wo };
+        let Some(lobe) = &self.lobe else {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            return Some(BsdfSample {
+                wi,
+                weight: self.tint * self.fresnel.eval(o.z),
+                pdf: 1.0,
+                lobe: LobeFlags::DELTA_REFLECTION,
+                eta: 1.0,
+            });
+        };
+        let (i, h, pdf) = lobe.sample(o, rng.next_2d())?;
+        let (geom, _, cos_oh) = lobe.geometry(o, i)?;
+        let weight = self.tint * self.fresnel.eval(cos_oh) * (geom * i.z / pdf);
+        Some(BsdfSample {
+            wi: if below { flip(i) } else { i },
+            weight,
+            pdf,
+            lobe: LobeFlags::GLOSSY_REFLECTION,
+            eta: 1.0,
+        })
+        .filter(|_| h.z > 0.0)
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        match (&self.lobe, to_upper_pair(wo, wi)) {
+            (Some(lobe), Some((o, i))) => lobe.pdf(o, i),
+            _ => 0.0,
+        }
+    }
+
+    fn lobe_width(&self) -> f64 {
+        self.lobe.as_ref().map_or(0.0, |l| l.typical_width())
+    }
+
+    fn describe(&self) -> String {
+        let fres = match &self.fresnel {
+            Fresnel::Conductor { eta, k } => format!("eta={:?}, k={:?}", eta.0, k.0),
+            Fresnel::One => "F=1".into(),
+            other => format!("{other:?}"),
+        };
+        match &self.lobe {
+            Some(l) => format!(
+                "conductor({}, masking={}, sampling={}, {fres})",
+                l.ndf.describe(),
+                l.masking.name(),
+                l.sampling().name()
+            ),
+            None => format!("conductor(smooth, {fres})"),
+        }
+    }
+}

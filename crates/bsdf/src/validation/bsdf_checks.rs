@@ -1,0 +1,443 @@
+//! Checks of one BSDF: chi-square of `sample` against `pdf` (globally and zoomed on each
+//! lobe), ∫ pdf ≤ 1, `pdf` equal to the density `sample` reports, `sample`'s weight equal to
+//! eval·|cos|/pdf, reciprocity (the generalized form f_t(i,o)/η_o² = f_t(o,i)/η_i² across a
+//! refractive interface, ERRATA 11), directional albedo ≤ 1 within Monte Carlo error, and a
+//! NaN/Inf sweep over random and degenerate directions.
+
+use super::chi2::{chi2_test_region, Chi2Config};
+use super::{rel_err, Check, SphereMap, Verdict};
+use crate::bsdf::{Bsdf, BsdfContext, LobeFlags, TransportMode};
+use crate::math::rng::{mix_seed, Pcg32, RandomSource};
+use crate::math::spectrum::Spectrum;
+use crate::math::warp::square_to_uniform_sphere;
+use crate::math::{refract, spherical_direction, Vec3};
+use rayon::prelude::*;
+
+/// Options for [`check_bsdf`].
+#[derive(Clone, Debug)]
+pub struct BsdfCheckOptions {
+    pub chi2: Chi2Config,
+    /// Incidence angles (degrees) of `wo`.
+    pub incidences_deg: Vec<f64>,
+    /// Azimuth of `wo` (radians), away from the axes so anisotropy shows.
+    pub azimuth: f64,
+    /// Random direction pairs of the NaN/Inf sweep.
+    pub sweep: usize,
+    /// Samples per directional albedo.
+    pub albedo_samples: usize,
+    /// Samples per sample/pdf/eval consistency check.
+    pub consistency_samples: usize,
+    /// Random pairs of the reciprocity check and its relative tolerance.
+    pub reciprocity_pairs: usize,
+    pub reciprocity_tol: f64,
+}
+
+impl Default for BsdfCheckOptions {
+    fn default() -> Self {
+        BsdfCheckOptions {
+            chi2: Chi2Config {
+                samples: 400_000,
+                ..Chi2Config::default()
+            },
+            incidences_deg: vec![0.0, 30.0, 60.0, 85.0],
+            azimuth: 0.4,
+            sweep: 1_000_000,
+            albedo_samples: 200_000,
+            consistency_samples: 20_000,
+            reciprocity_pairs: 4000,
+            reciprocity_tol: 1e-4,
+        }
+    }
+}
+
+/// Index of refraction of the side of `w` relative to the outside.
+fn side_index(bsdf: &dyn Bsdf, w: Vec3) -> f64 {
+    match bsdf.relative_ior() {
+        Some(eta) if w.z < 0.0 => eta,
+        _ => 1.0,
+    }
+}
+
+/// The directions `wo` the checks use: the incidences on the front side, and for
+/// transmissive models the same on the back side.
+fn incident_directions(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Vec<(String, Vec3)> {
+    let mut v = Vec::new();
+    for &t in &opts.incidences_deg {
+        let w = spherical_direction(t.to_radians(), opts.azimuth);
+        v.push((format!("θ_o = {t}°"), w));
+    }
+    if bsdf.flags().intersects(LobeFlags::TRANSMISSION) {
+        for &t in &opts.incidences_deg {
+            let w = spherical_direction(t.to_radians(), opts.azimuth);
+            v.push((format!("θ_o = {t}° from inside"), Vec3::new(w.x, w.y, -w.z)));
+        }
+    } else {
+        // Opaque models are two-sided: one check from below.
+        let w = spherical_direction(30f64.to_radians(), opts.azimuth);
+        v.push(("θ_o = 30° from below".into(), Vec3::new(w.x, w.y, -w.z)));
+    }
+    v
+}
+
+/// Every check for one BSDF.
+pub fn check_bsdf(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Vec<Check> {
+    let subject = bsdf.describe();
+    let mut out = Vec::new();
+    let dirs = incident_directions(bsdf, opts);
+    let ctx = BsdfContext::RADIANCE;
+    let width = bsdf.lobe_width();
+    for (k, (label, wo)) in dirs.iter().enumerate() {
+        let wo = *wo;
+        if bsdf.flags().has_smooth_part() {
+            // Broad lobes: one test over the whole sphere. Narrow lobes: one test per side,
+            // zoomed on the lobe of that side (reflection about the mirror direction,
+            // transmission about the smooth refraction direction).
+            let side = wo.z.signum();
+            let mut tests: Vec<(String, SphereMap, f64)> = Vec::new();
+            if width > 0.0 && width < 0.14 {
+                if bsdf.flags().intersects(LobeFlags::REFLECTION) {
+                    tests.push((
+                        " (reflection side, zoomed on the mirror direction)".into(),
+                        SphereMap::new(Vec3::new(-wo.x, -wo.y, wo.z), width),
+                        side,
+                    ));
+                }
+                if bsdf.flags().intersects(LobeFlags::TRANSMISSION) {
+                    let eta = bsdf.relative_ior().unwrap_or(1.0);
+                    let (n, rel) = if wo.z > 0.0 {
+                        (Vec3::Z, 1.0 / eta)
+                    } else {
+                        (-Vec3::Z, eta)
+                    };
+                    let axis =
+                        refract(wo, n, rel).unwrap_or(Vec3::new(wo.x, wo.y, -wo.z).normalize());
+                    tests.push((
+                        " (transmission side, zoomed on the refraction direction)".into(),
+                        SphereMap::new(axis, width),
+                        -side,
+                    ));
+                }
+            } else {
+                tests.push((String::new(), SphereMap::standard(), 0.0));
+            }
+            let mut integral = 0.0;
+            for (j, (tag, map, region_side)) in tests.iter().enumerate() {
+                let cfg = Chi2Config {
+                    seed: mix_seed(opts.chi2.seed, (k * 8 + j) as u64),
+                    ..opts.chi2
+                };
+                let rs = *region_side;
+                let o = chi2_test_region(
+                    map,
+                    &cfg,
+                    |wi| rs == 0.0 || wi.z * rs > 0.0,
+                    |r| match bsdf.sample(wo, &ctx, r) {
+                        Some(s) if !s.lobe.is_delta() => Some(s.wi),
+                        _ => None,
+                    },
+                    |wi| bsdf.pdf(wo, wi, &ctx),
+                );
+                integral += o.pdf_integral;
+                out.push(Check::chi2(
+                    &subject,
+                    format!("chi-square at {label}{tag}"),
+                    &o,
+                ));
+            }
+            out.push(Check::new(
+                &subject,
+                format!("∫ pdf dω ≤ 1 at {label}"),
+                format!("{integral:.5}"),
+                Verdict::from_bool(integral <= 1.0 + 2e-3),
+            ));
+            out.push(consistency_check(bsdf, wo, label, opts));
+        }
+        out.push(albedo_check(bsdf, wo, label, opts));
+    }
+    if bsdf.flags().has_smooth_part() {
+        out.push(reciprocity_check(bsdf, opts));
+    }
+    out.push(sweep_check(bsdf, opts));
+    out
+}
+
+/// `pdf(wo, wi)` equals the density `sample` reports, and the weight equals
+/// eval·|cos|/pdf, in both transport modes.
+fn consistency_check(bsdf: &dyn Bsdf, wo: Vec3, label: &str, opts: &BsdfCheckOptions) -> Check {
+    let mut worst_pdf: f64 = 0.0;
+    let mut worst_weight: f64 = 0.0;
+    let mut n = 0usize;
+    for (m, mode) in [TransportMode::Radiance, TransportMode::Importance]
+        .iter()
+        .enumerate()
+    {
+        let ctx = BsdfContext { mode: *mode };
+        let mut rng = Pcg32::new(mix_seed(opts.chi2.seed, 77 + m as u64), 3);
+        for _ in 0..opts.consistency_samples {
+            let Some(s) = bsdf.sample(wo, &ctx, &mut rng) else {
+                continue;
+            };
+            if s.lobe.is_delta() {
+                continue;
+            }
+            n += 1;
+            worst_pdf = worst_pdf.max(rel_err(bsdf.pdf(wo, s.wi, &ctx), s.pdf));
+            if !bsdf.is_stochastic() {
+                let f = bsdf.eval(wo, s.wi, &ctx, &mut rng);
+                let expect = f * (s.wi.z.abs() / s.pdf);
+                for c in 0..3 {
+                    let e = if expect[c].abs() < 1e-12 {
+                        (s.weight[c] - expect[c]).abs()
+                    } else {
+                        rel_err(s.weight[c], expect[c])
+                    };
+                    worst_weight = worst_weight.max(e);
+                }
+            }
+        }
+    }
+    let ok = worst_pdf <= 1e-6 && worst_weight <= 1e-6;
+    let w = if bsdf.is_stochastic() {
+        "weight is a stochastic estimate (checked through the albedo)".to_string()
+    } else {
+        format!("weight vs eval·|cos|/pdf max relative error {worst_weight:.1e}")
+    };
+    Check::new(
+        bsdf.describe(),
+        format!("sample/pdf/eval consistency at {label}"),
+        format!("{n} samples: pdf vs sample's pdf max relative error {worst_pdf:.1e}; {w} (tolerance 1e-6)"),
+        Verdict::from_bool(ok),
+    )
+}
+
+/// Directional albedo (reflectance + transmittance) by the mean sample weight.
+pub fn directional_albedo(
+    bsdf: &dyn Bsdf,
+    wo: Vec3,
+    ctx: &BsdfContext,
+    samples: usize,
+    seed: u64,
+) -> (Spectrum, Spectrum, Spectrum, Spectrum) {
+    const CHUNKS: usize = 32;
+    let per = samples.div_ceil(CHUNKS);
+    let parts: Vec<[Spectrum; 4]> = (0..CHUNKS)
+        .into_par_iter()
+        .map(|c| {
+            let mut rng = Pcg32::new(mix_seed(seed, c as u64), 5);
+            let mut acc = [Spectrum::ZERO; 4];
+            for _ in 0..per {
+                if let Some(s) = bsdf.sample(wo, ctx, &mut rng) {
+                    let w = s.weight;
+                    if s.wi.z * wo.z > 0.0 {
+                        acc[0] += w;
+                        acc[1] += w * w;
+                    } else {
+                        acc[2] += w;
+                        acc[3] += w * w;
+                    }
+                }
+            }
+            acc
+        })
+        .collect();
+    let n = (per * CHUNKS) as f64;
+    let mut sum = [Spectrum::ZERO; 4];
+    for p in parts {
+        for k in 0..4 {
+            sum[k] += p[k];
+        }
+    }
+    let stats = |s: Spectrum, s2: Spectrum| {
+        let mean = s / n;
+        let var = (s2 / n - mean * mean).map(|v| v.max(0.0));
+        (mean, (var / n).map(f64::sqrt))
+    };
+    let (r, rse) = stats(sum[0], sum[1]);
+    let (t, tse) = stats(sum[2], sum[3]);
+    (r, rse, t, tse)
+}
+
+fn albedo_check(bsdf: &dyn Bsdf, wo: Vec3, label: &str, opts: &BsdfCheckOptions) -> Check {
+    let (r, rse, t, tse) = directional_albedo(
+        bsdf,
+        wo,
+        &BsdfContext::IMPORTANCE,
+        opts.albedo_samples,
+        mix_seed(opts.chi2.seed, 991),
+    );
+    let total = r + t;
+    let se = (rse * rse + tse * tse).map(f64::sqrt);
+    let mut ok = total.is_finite();
+    for c in 0..3 {
+        ok &= total[c] <= 1.0 + 3.0 * se[c] + 1e-9;
+    }
+    let fig = if bsdf.flags().intersects(LobeFlags::TRANSMISSION) {
+        format!(
+            "R = {:.4} ± {:.1e}, T = {:.4} ± {:.1e}, R + T = {:.4} (green channel)",
+            r[1], rse[1], t[1], tse[1], total[1]
+        )
+    } else {
+        format!(
+            "R = {:.4} ± {:.1e} (green channel; max over channels {:.4})",
+            r[1],
+            rse[1],
+            total.max_component()
+        )
+    };
+    Check::new(
+        bsdf.describe(),
+        format!("directional albedo ≤ 1 within 3 standard errors at {label}"),
+        fig,
+        Verdict::from_bool(ok),
+    )
+}
+
+fn reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
+    let mut rng = Pcg32::new(mix_seed(opts.chi2.seed, 4242), 8);
+    let transmissive = bsdf.flags().intersects(LobeFlags::TRANSMISSION);
+    let mut worst_r: f64 = 0.0;
+    let mut worst_t: f64 = 0.0;
+    let mut worst_mode: f64 = 0.0;
+    let seed = mix_seed(opts.chi2.seed, 17);
+    // Stochastic models get the same random numbers for both orders.
+    let eval = |a: Vec3, b: Vec3, mode: TransportMode| {
+        let mut r = Pcg32::new(seed, 1);
+        bsdf.eval(a, b, &BsdfContext { mode }, &mut r)
+    };
+    let tol = opts.reciprocity_tol;
+    let err = |x: Spectrum, y: Spectrum| -> f64 {
+        (0..3)
+            .map(|c| {
+                let scale = x[c].abs().max(y[c].abs());
+                if scale < 1e-10 {
+                    0.0
+                } else {
+                    (x[c] - y[c]).abs() / scale
+                }
+            })
+            .fold(0.0, f64::max)
+    };
+    for _ in 0..opts.reciprocity_pairs {
+        let a = square_to_uniform_sphere(rng.next_2d());
+        let mut b = square_to_uniform_sphere(rng.next_2d());
+        if !transmissive && a.z * b.z < 0.0 {
+            b.z = -b.z;
+        }
+        let fab = eval(a, b, TransportMode::Radiance);
+        let fba = eval(b, a, TransportMode::Radiance);
+        if a.z * b.z > 0.0 {
+            worst_r = worst_r.max(err(fab, fba));
+        } else {
+            // eval_rad(a, b) = f(i=b, o=a): f(i,o)/η_o² = f(o,i)/η_i².
+            let (na, nb) = (side_index(bsdf, a), side_index(bsdf, b));
+            worst_t = worst_t.max(err(fab / (na * na), fba / (nb * nb)));
+            // Importance mode is the adjoint: eval_imp(b, a) = eval_rad(a, b).
+            worst_mode = worst_mode.max(err(fab, eval(b, a, TransportMode::Importance)));
+        }
+    }
+    let ok = worst_r <= tol && worst_t <= tol && worst_mode <= 1e-12;
+    let fig = if transmissive {
+        format!(
+            "{} pairs: BRDF max relative error {worst_r:.1e}; BTDF f_t(i,o)/η_o² vs f_t(o,i)/η_i² {worst_t:.1e}; radiance vs importance adjoint {worst_mode:.1e} (tolerance {tol:.0e})",
+            opts.reciprocity_pairs
+        )
+    } else {
+        format!(
+            "{} pairs: max relative error {worst_r:.1e} (tolerance {tol:.0e})",
+            opts.reciprocity_pairs
+        )
+    };
+    Check::new(bsdf.describe(), "reciprocity", fig, Verdict::from_bool(ok))
+}
+
+/// Directions that stress the code paths: poles, the tangent plane, just above and below it.
+pub fn degenerate_directions() -> Vec<Vec3> {
+    let mut v = vec![
+        Vec3::Z,
+        -Vec3::Z,
+        Vec3::X,
+        Vec3::Y,
+        Vec3::new(0.6, 0.8, 0.0),
+        Vec3::new(1.0, 0.0, 1e-12).normalize(),
+        Vec3::new(1.0, 0.0, -1e-12).normalize(),
+        Vec3::new(0.0, 1.0, 1e-300).normalize(),
+        Vec3::new(1e-9, 0.0, 1.0).normalize(),
+        Vec3::new(-1e-9, 1e-9, -1.0).normalize(),
+        spherical_direction(89.999f64.to_radians(), 0.3),
+        spherical_direction(45f64.to_radians(), 0.0),
+    ];
+    let more: Vec<Vec3> = v.iter().map(|d| Vec3::new(-d.x, -d.y, d.z)).collect();
+    v.extend(more);
+    v
+}
+
+fn sweep_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
+    let degenerate = degenerate_directions();
+    const CHUNKS: usize = 64;
+    let per = opts.sweep.div_ceil(CHUNKS);
+    let problems: Vec<String> = (0..CHUNKS)
+        .into_par_iter()
+        .flat_map_iter(|c| {
+            let mut rng = Pcg32::new(mix_seed(opts.chi2.seed, 5000 + c as u64), 2);
+            let mut probs = Vec::new();
+            let mut pairs: Vec<(Vec3, Vec3)> = Vec::new();
+            if c == 0 {
+                for &a in &degenerate {
+                    for &b in &degenerate {
+                        pairs.push((a, b));
+                    }
+                }
+            }
+            for _ in 0..per {
+                pairs.push((
+                    square_to_uniform_sphere(rng.next_2d()),
+                    square_to_uniform_sphere(rng.next_2d()),
+                ));
+            }
+            for (k, (a, b)) in pairs.into_iter().enumerate() {
+                let mode = if k % 2 == 0 {
+                    TransportMode::Radiance
+                } else {
+                    TransportMode::Importance
+                };
+                let ctx = BsdfContext { mode };
+                let f = bsdf.eval(a, b, &ctx, &mut rng);
+                if !f.is_finite() || f.has_negative() {
+                    probs.push(format!("eval({a:?}, {b:?}) = {:?}", f.0));
+                }
+                let p = bsdf.pdf(a, b, &ctx);
+                if !(p.is_finite() && p >= 0.0) {
+                    probs.push(format!("pdf({a:?}, {b:?}) = {p}"));
+                }
+                if let Some(s) = bsdf.sample(a, &ctx, &mut rng) {
+                    let unit = (s.wi.length() - 1.0).abs() < 1e-9;
+                    if !(s.wi.is_finite()
+                        && unit
+                        && s.weight.is_finite()
+                        && !s.weight.has_negative()
+                        && s.pdf > 0.0
+                        && s.pdf.is_finite())
+                    {
+                        probs.push(format!("sample({a:?}) = {s:?}"));
+                    }
+                }
+                if probs.len() > 3 {
+                    break;
+                }
+            }
+            probs
+        })
+        .collect();
+    let total = opts.sweep + degenerate.len() * degenerate.len();
+    let ok = problems.is_empty();
+    Check::new(
+        bsdf.describe(),
+        "NaN/Inf sweep of eval, pdf and sample over random and degenerate directions",
+        if ok {
+            format!("{total} direction pairs, all finite and non-negative")
+        } else {
+            problems.into_iter().take(4).collect::<Vec<_>>().join("; ")
+        },
+        Verdict::from_bool(ok),
+    )
+}

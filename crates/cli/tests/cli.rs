@@ -1,0 +1,269 @@
+//! End-to-end tests of the `facette` command line.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn facette(args: &[&str], stdin: Option<&str>) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("facette runs");
+    if let Some(s) = stdin {
+        // The process may exit before reading (on a bad argument): ignore a broken pipe.
+        let _ = child.stdin.take().unwrap().write_all(s.as_bytes());
+    } else {
+        drop(child.stdin.take());
+    }
+    child.wait_with_output().unwrap()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The numeric columns of the data rows of a CSV output.
+fn rows(o: &Output) -> Vec<Vec<f64>> {
+    stdout(o)
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect()
+}
+
+#[test]
+fn eval_lambert_is_kd_over_pi() {
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "lambert", reflectance = [0.2, 0.4, 0.6]}"#,
+        ],
+        Some("theta_i,phi_i,theta_o,phi_o\n30,0,60,120\n0,0,89,0\n"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = rows(&o);
+    assert_eq!(r.len(), 2);
+    for row in &r {
+        for (c, kd) in [0.2, 0.4, 0.6].iter().enumerate() {
+            assert!(
+                (row[4 + c] - kd / std::f64::consts::PI).abs() < 1e-9,
+                "{row:?}"
+            );
+        }
+    }
+    // Directions on opposite sides: zero for a BRDF.
+    let o = facette(
+        &["eval", "--material", r#"{type = "lambert"}"#],
+        Some("30,0,120,0\n"),
+    );
+    assert_eq!(rows(&o)[0][4], 0.0);
+}
+
+#[test]
+fn eval_reads_a_file_and_reports_bad_rows_with_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("dirs.csv");
+    std::fs::write(&p, "# comment\n30,0,30,180\n10,0,abc,0\n").unwrap();
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "conductor", alpha = 0.2}"#,
+            "--input",
+            p.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("dirs.csv:3") && e.contains("not a finite number"),
+        "{e}"
+    );
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "lambert"}"#,
+            "--input",
+            "/nonexistent.csv",
+        ],
+        None,
+    );
+    assert!(!o.status.success() && stderr(&o).contains("cannot open"));
+}
+
+#[test]
+fn eval_dielectric_matches_walter_and_is_reciprocal_in_the_generalized_sense() {
+    let m = r#"{type = "dielectric", distribution = "ggx", alpha = 0.3, ior = 1.5}"#;
+    // f_t(i,o)/η_o² = f_t(o,i)/η_i²: i outside (η = 1), o inside (η = 1.5).
+    let o = facette(
+        &["eval", "--material", m],
+        Some("30,0,160,180\n160,180,30,0\n"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = rows(&o);
+    let (f_io, f_oi) = (r[0][4], r[1][4]);
+    assert!(f_io > 0.0);
+    assert!(
+        (f_io / (1.5 * 1.5) - f_oi).abs() < 1e-9 * f_io,
+        "{f_io} {f_oi}"
+    );
+}
+
+#[test]
+fn stochastic_models_print_a_converged_estimate_and_say_so() {
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "oren-nayar", sigma = 0.4, evaluation = "stochastic"}"#,
+            "--samples",
+            "200000",
+        ],
+        Some("30,0,40,90\n"),
+    );
+    assert!(o.status.success());
+    assert!(stderr(&o).contains("averages 200000"));
+    let v = rows(&o)[0][4];
+    // The quadrature mode gives the same value.
+    let q = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "oren-nayar", sigma = 0.4, samples = 65536}"#,
+        ],
+        Some("30,0,40,90\n"),
+    );
+    let w = rows(&q)[0][4];
+    assert!((v - w).abs() < 0.01 * w, "{v} vs {w}");
+}
+
+#[test]
+fn albedo_of_the_smooth_dielectric_is_fresnel() {
+    let o = facette(
+        &[
+            "albedo",
+            "--material",
+            r#"{type = "dielectric", alpha = 0, ior = 1.5}"#,
+            "--theta-i",
+            "0",
+            "60",
+            "--samples",
+            "400000",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = rows(&o);
+    for (row, deg) in r.iter().zip([0.0f64, 60.0]) {
+        let f = facette_fresnel(deg.to_radians().cos(), 1.5);
+        let (refl, se) = (row[1], row[4]);
+        assert!(
+            (refl - f).abs() < 4.0 * se + 1e-9,
+            "{deg}: {refl} ± {se} vs {f}"
+        );
+        assert!(
+            (row[1] + row[7] - 1.0).abs() < 1e-9,
+            "R + T = 1 for a lossless interface"
+        );
+    }
+}
+
+/// Fresnel for the test's expected values (unpolarized, s/p amplitudes).
+fn facette_fresnel(c: f64, eta: f64) -> f64 {
+    let s2 = (1.0 - c * c) / (eta * eta);
+    let ct = (1.0 - s2).sqrt();
+    let rs = (c - eta * ct) / (c + eta * ct);
+    let rp = (eta * c - ct) / (eta * c + ct);
+    0.5 * (rs * rs + rp * rp)
+}
+
+#[test]
+fn albedo_of_white_lambert_is_one() {
+    let o = facette(
+        &[
+            "albedo",
+            "--material",
+            r#"{type = "lambert", reflectance = 1}"#,
+            "--theta-i",
+            "45",
+        ],
+        None,
+    );
+    let r = rows(&o);
+    assert!((r[0][1] - 1.0).abs() < 1e-12 && r[0][7] == 0.0);
+}
+
+#[test]
+fn validate_material_passes_and_prints_a_summary() {
+    let o = facette(
+        &[
+            "validate",
+            "--material",
+            r#"{type = "conductor", distribution = "ggx", alpha_u = 0.1, alpha_v = 0.3}"#,
+            "--samples",
+            "100000",
+        ],
+        None,
+    );
+    let out = stdout(&o);
+    assert!(o.status.success(), "{out}");
+    let last = out.lines().last().unwrap();
+    assert!(last.contains("passed, 0 failed"), "{last}");
+    assert!(out.contains("[PASS]") && out.contains("chi-square") && out.contains("reciprocity"));
+}
+
+#[test]
+fn validate_distribution_and_family() {
+    let o = facette(
+        &[
+            "validate",
+            "--distribution",
+            r#"{distribution = "beckmann", alpha = 0.2}"#,
+            "--samples",
+            "100000",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stdout(&o));
+    assert!(stdout(&o).contains("analytic Smith Λ vs numerical IL18 eq. 19"));
+}
+
+#[test]
+fn bad_materials_are_clear_errors_with_nonzero_exit() {
+    for (m, needle) in [
+        (
+            r#"{type = "glass"}"#,
+            "lambert, oren-nayar, conductor, dielectric, kelemen",
+        ),
+        (
+            r#"{type = "conductor", alpha = 0.2, roughness = 1}"#,
+            "unknown key `roughness`",
+        ),
+        (
+            r#"{type = "conductor", alpha = -1}"#,
+            "`alpha` = -1 is out of range",
+        ),
+        (
+            r#"{type = "dielectric", alpha = 0.1, ior = nan}"#,
+            "must be a finite number",
+        ),
+        (
+            r#"{type = "conductor", distribution = "gaussian", sigma = 0.2, masking = "smith"}"#,
+            "diverges",
+        ),
+        (r#"{type = "lambert""#, "not a TOML inline table"),
+    ] {
+        let o = facette(&["eval", "--material", m], Some("0,0,0,0\n"));
+        assert_eq!(o.status.code(), Some(1), "{m}");
+        assert!(stderr(&o).contains(needle), "{m}: {}", stderr(&o));
+    }
+}
