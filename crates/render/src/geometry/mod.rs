@@ -1,0 +1,1 @@
+//! Geometry: rays, transforms, shapes, meshes and the BVH.
