@@ -53,7 +53,30 @@ fn models(c: &mut Criterion) {
             )
         })
         .collect();
-    for (name, toml) in MODELS {
+    // The tabulated IL body term (5° grid, 10 000 microfacets per entry), saved to a
+    // temporary file and loaded through the material syntax.
+    let table_path = std::env::temp_dir().join("facette-bench-il-5deg.fctab");
+    {
+        use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
+        use facette_bsdf::microfacet::{Beckmann, Masking, Ndf};
+        let lobe = SpecularLobe::new(
+            Ndf::Beckmann(Beckmann::isotropic(0.3).unwrap()),
+            Masking::SmithSeparable,
+            NormalSampling::Visible,
+        )
+        .unwrap();
+        facette_bsdf::models::il_table::BodyTable::build(&lobe, 1.5, 5.0, 10_000, &|_, _| {})
+            .unwrap()
+            .save(&table_path)
+            .unwrap();
+    }
+    let table_toml = format!(
+        r#"{{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3, table = "{}"}}"#,
+        table_path.display()
+    );
+    let mut all: Vec<(&str, String)> = MODELS.iter().map(|(n, t)| (*n, t.to_string())).collect();
+    all.push(("il-table-5deg", table_toml));
+    for (name, toml) in &all {
         let bsdf = build_material(&parse_inline_table(toml).unwrap()).unwrap();
         let mut g = c.benchmark_group(*name);
         g.throughput(Throughput::Elements(256));
@@ -99,6 +122,32 @@ fn models(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(std::time::Duration::from_millis(300)).measurement_time(std::time::Duration::from_secs(1));
-    targets = models
+    targets = models, il_tables
 }
 criterion_main!(benches);
+
+/// Building a 5° and a 10° IL body table with 10 000 microfacets per entry (TSBRM §4.3
+/// reports 1 min 43 s and 13 s).
+fn il_tables(c: &mut Criterion) {
+    use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
+    use facette_bsdf::microfacet::{Gaussian, Masking, Ndf};
+    let lobe = SpecularLobe::new(
+        Ndf::Gaussian(Gaussian::new(0.3).unwrap()),
+        Masking::VCavity,
+        NormalSampling::Distribution,
+    )
+    .unwrap();
+    let mut g = c.benchmark_group("il-table-build");
+    g.sample_size(10);
+    for step in [10.0, 5.0] {
+        g.bench_function(format!("step-{step}deg-10000-samples"), |b| {
+            b.iter(|| {
+                black_box(
+                    facette_bsdf::models::il_table::BodyTable::build(&lobe, 1.2, step, 10_000, &|_, _| {})
+                        .unwrap(),
+                )
+            })
+        });
+    }
+    g.finish();
+}

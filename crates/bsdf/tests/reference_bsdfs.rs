@@ -41,3 +41,8 @@ fn dielectrics() {
 fn kelemen() {
     assert_report(&material_suite(&opts(), Some("kelemen")));
 }
+
+#[test]
+fn interfaced_lambertian() {
+    assert_report(&material_suite(&opts(), Some("\"il\"")));
+}

@@ -3,8 +3,11 @@
 
 mod cmd_albedo;
 mod cmd_eval;
+mod cmd_il_approx;
+mod cmd_tabulate;
 mod cmd_validate;
 mod material_arg;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -31,6 +34,10 @@ enum Command {
     Albedo(cmd_albedo::AlbedoArgs),
     /// Statistical validation: the microfacet core suite, one distribution, or a material.
     Validate(cmd_validate::ValidateArgs),
+    /// Tabulate the body term of an interfaced-Lambertian material (TSBRM §4.3).
+    Tabulate(cmd_tabulate::TabulateArgs),
+    /// Fit or measure the approximate interfaced-Lambertian body term (IL18 §4.2).
+    IlApprox(cmd_il_approx::IlApproxArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +46,8 @@ fn main() -> ExitCode {
         Command::Eval(a) => cmd_eval::run(a),
         Command::Albedo(a) => cmd_albedo::run(a),
         Command::Validate(a) => cmd_validate::run(a),
+        Command::Tabulate(a) => cmd_tabulate::run(a),
+        Command::IlApprox(a) => cmd_il_approx::run(a),
     };
     match result {
         Ok(code) => code,

@@ -1,13 +1,19 @@
 //! The BSDF models, one file per model, each built from the shared parts of
 //! [`crate::microfacet`] (one specular lobe, one microfacet integrator).
 
+pub mod il_approx;
+pub mod il_approx_coefficients;
+pub mod il_table;
+pub mod interfaced_lambertian;
 pub mod kelemen;
 pub mod lambert;
 pub mod microfacet_integral;
 pub mod oren_nayar;
 pub mod rough_conductor;
 pub mod rough_dielectric;
+pub mod vcavity;
 
+pub use interfaced_lambertian::InterfacedLambertian;
 pub use kelemen::Kelemen;
 pub use lambert::Lambert;
 pub use oren_nayar::{OrenNayarExact, OrenNayarQualitative};

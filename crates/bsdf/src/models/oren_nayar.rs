@@ -6,13 +6,15 @@
 //!   TSBRM eq. 27), evaluated by the shared [`MicrofacetIntegral`].
 //! - [`OrenNayarQualitative`]: Oren & Nayar's qualitative model (SIGGRAPH 1994, eq. 30):
 //!   f = ρ/π (A + B max(0, cos(φ_i − φ_o)) sin α tan β), A = 1 − 0.5σ²/(σ² + 0.33),
-//!   B = 0.45σ²/(σ² + 0.09), α = max(θ_i, θ_o), β = min(θ_i, θ_o).
+//!   B = 0.45σ²/(σ² + 0.09), α = max(θ_i, θ_o), β = min(θ_i, θ_o) — or, with `model = "l1"`,
+//!   their fuller approximation of the same single-scattering term (L1, coefficients C1–C3;
+//!   [`oren_nayar_l1_factor`]).
 //!
 //! | key | meaning | range | default |
 //! |---|---|---|---|
 //! | `reflectance` | facet albedo K_d (number or RGB) | [0, 1] | 0.5 |
 //! | `sigma` | Gaussian roughness, radians | (0, π/2) (0 = Lambert) | required |
-//! | `model` | `exact` or `qualitative` | — | `exact` |
+//! | `model` | `exact`, `qualitative` or `l1` | — | `exact` |
 //! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (N microfacets, deterministic) | — | `quadrature` |
 //! | `samples` | exact, quadrature: microfacets per evaluation | ≥ 8 | 256 |
 
@@ -139,7 +141,12 @@ impl Bsdf for OrenNayarExact {
         };
         let (v, se) = match self.evaluation {
             IntegralEvaluation::Quadrature { .. } => self.integral_value(i, o, rng),
-            IntegralEvaluation::Stochastic => self.integral.estimate(i, o, samples, rng, |_| 1.0),
+            IntegralEvaluation::Stochastic => {
+                let (m, se) = crate::bsdf::mean_and_stderr(samples, || {
+                    Spectrum::splat(self.integral.estimate_one(i, o, rng.next_2d(), |_| 1.0))
+                });
+                (m[0], se[0])
+            }
         };
         let _ = ctx;
         (
@@ -185,12 +192,48 @@ impl Bsdf for OrenNayarExact {
     }
 }
 
+/// The scalar factor of Oren & Nayar's L1 model (single scattering, SIGGRAPH 1994, their
+/// eq. 26 with the coefficients C1–C3): f·π/ρ = C1 + cos Δφ C2 tan β + (1 − |cos Δφ|) C3
+/// tan((α + β)/2), for i and o in the upper hemisphere. `c` scales (C1's σ term, C2, C3):
+/// (1, 1, 1) is Oren & Nayar's Gaussian model; the IL approximation fits other values for
+/// Beckmann facets.
+pub fn oren_nayar_l1_factor(sigma: f64, c: [f64; 3], i: Vec3, o: Vec3) -> f64 {
+    let s2 = sigma * sigma;
+    let (ti, to) = (i.z.clamp(-1.0, 1.0).acos(), o.z.clamp(-1.0, 1.0).acos());
+    let (alpha, beta) = (ti.max(to), ti.min(to));
+    let (si, so) = ((1.0 - i.z * i.z).max(0.0).sqrt(), (1.0 - o.z * o.z).max(0.0).sqrt());
+    let cos_dphi = if si > 1e-12 && so > 1e-12 {
+        ((i.x * o.x + i.y * o.y) / (si * so)).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    let c1 = 1.0 - c[0] * 0.5 * s2 / (s2 + 0.33);
+    let k = 0.45 * s2 / (s2 + 0.09);
+    let c2 = c[1]
+        * if cos_dphi >= 0.0 {
+            k * alpha.sin()
+        } else {
+            k * (alpha.sin() - (2.0 * beta / PI).powi(3))
+        };
+    let c3 = c[2] * 0.125 * (s2 / (s2 + 0.09)) * (4.0 * alpha * beta / (PI * PI)).powi(2);
+    let tan_b = beta.tan();
+    let tan_ab = (0.5 * (alpha + beta)).tan();
+    let v = c1 + cos_dphi * c2 * tan_b + (1.0 - cos_dphi.abs()) * c3 * tan_ab;
+    if v.is_finite() {
+        v.max(0.0)
+    } else {
+        0.0
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct OrenNayarQualitative {
     reflectance: Spectrum,
     sigma: f64,
     a: f64,
     b: f64,
+    /// Use the L1 model instead of the qualitative one.
+    l1: bool,
 }
 
 impl OrenNayarQualitative {
@@ -203,12 +246,23 @@ impl OrenNayarQualitative {
             sigma,
             a: 1.0 - 0.5 * s2 / (s2 + 0.33),
             b: 0.45 * s2 / (s2 + 0.09),
+            l1: false,
         })
+    }
+
+    /// Oren & Nayar's L1 model (C1–C3) instead of the qualitative one.
+    pub fn l1(reflectance: Spectrum, sigma: f64) -> ParamResult<Self> {
+        let mut m = Self::new(reflectance, sigma)?;
+        m.l1 = true;
+        Ok(m)
     }
 
     /// The scalar factor A + B max(0, cos Δφ) sin α tan β, for i and o in the upper
     /// hemisphere.
     pub fn factor(&self, i: Vec3, o: Vec3) -> f64 {
+        if self.l1 {
+            return oren_nayar_l1_factor(self.sigma, [1.0; 3], i, o);
+        }
         let (si, so) = (
             (1.0 - i.z * i.z).max(0.0).sqrt(),
             (1.0 - o.z * o.z).max(0.0).sqrt(),
@@ -271,7 +325,8 @@ impl Bsdf for OrenNayarQualitative {
 
     fn describe(&self) -> String {
         format!(
-            "oren-nayar qualitative(reflectance={:?}, sigma={})",
+            "oren-nayar {}(reflectance={:?}, sigma={})",
+            if self.l1 { "l1" } else { "qualitative" },
             self.reflectance.0,
             fmt_num(self.sigma)
         )

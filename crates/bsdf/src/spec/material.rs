@@ -10,11 +10,15 @@ use crate::math::spectrum::Spectrum;
 use crate::microfacet::half_vector_density::HalfVectorDensity;
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::Ndf;
+use crate::models::il_approx::IlApprox;
+use crate::models::il_table::BodyTable;
+use crate::models::interfaced_lambertian::{BodyEvaluation, Scattering};
 use crate::models::kelemen::check_ior;
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::rough_dielectric::{MEASURED_GLASSES, MEASURED_GLASS_IOR};
 use crate::models::{
-    Kelemen, Lambert, OrenNayarExact, OrenNayarQualitative, RoughConductor, RoughDielectric,
+    InterfacedLambertian, Kelemen, Lambert, OrenNayarExact, OrenNayarQualitative, RoughConductor,
+    RoughDielectric,
 };
 use std::sync::Arc;
 
@@ -36,8 +40,15 @@ fn keys(extra: &[&'static str], micro: bool) -> Vec<&'static str> {
     v
 }
 
-/// Builds the BSDF described by `table`.
+/// Builds the BSDF described by `table`; relative file paths (an IL `table`) are resolved
+/// against the current directory.
 pub fn build_material(table: &toml::Table) -> ParamResult<Arc<dyn Bsdf>> {
+    build_material_in(table, std::path::Path::new("."))
+}
+
+/// Builds the BSDF described by `table`, resolving relative file paths against `base_dir`
+/// (a scene file's directory).
+pub fn build_material_in(table: &toml::Table, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>> {
     let ty = match table.get("type") {
         Some(toml::Value::String(s)) => s.as_str(),
         Some(_) => return Err(ParamError::Invalid("`type` must be a string".into())),
@@ -60,6 +71,7 @@ pub fn build_material(table: &toml::Table) -> ParamResult<Arc<dyn Bsdf>> {
         "conductor" => build_conductor(&p),
         "dielectric" => build_dielectric(&p),
         "kelemen" => build_kelemen(&p),
+        "il" | "interfaced-lambertian" => build_il(&p, base_dir),
         other => Err(ParamError::UnknownChoice {
             what: "material type".into(),
             given: other.into(),
@@ -115,7 +127,11 @@ fn build_oren_nayar(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
             p.finish(&keys(&["reflectance", "sigma", "model"], false))?;
             Arc::new(OrenNayarQualitative::new(r, sigma)?)
         }
-        other => return Err(choice("model", other, &["exact", "qualitative"])),
+        "l1" => {
+            p.finish(&keys(&["reflectance", "sigma", "model"], false))?;
+            Arc::new(OrenNayarQualitative::l1(r, sigma)?)
+        }
+        other => return Err(choice("model", other, &["exact", "qualitative", "l1"])),
     };
     Ok(out)
 }
@@ -276,6 +292,60 @@ fn build_dielectric(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
         rt,
         tt,
     )?))
+}
+
+fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>> {
+    let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
+    let ni = p.f64_or("ni", 1.5)?;
+    let scattering = Scattering::parse(p.str("scattering")?.unwrap_or("single"))?;
+    let ndf = parse_distribution(p, true)?;
+    let masking = match p.str("masking")? {
+        Some(m) => crate::microfacet::Masking::parse(m)?,
+        None if scattering != Scattering::Single => crate::microfacet::Masking::VCavity,
+        None => parse_masking(p, ndf.as_ref())?,
+    };
+    let sampling = match p.str("sampling")? {
+        None => NormalSampling::Visible,
+        Some(s) => NormalSampling::parse(s)?,
+    };
+    let samples = p.usize("samples")?;
+    let table_path = p.str("table")?;
+    let evaluation = match p.str("evaluation")?.unwrap_or(if table_path.is_some() { "table" } else { "stochastic" }) {
+        "stochastic" => BodyEvaluation::Stochastic,
+        "quadrature" => BodyEvaluation::Quadrature {
+            samples: samples.unwrap_or(1024),
+        },
+        "table" => {
+            let path = table_path.ok_or_else(|| ParamError::MissingKey {
+                key: "table (path of a file written by `facette tabulate`)".into(),
+                context: p.context().into(),
+            })?;
+            let full = base_dir.join(path);
+            let t = BodyTable::load(&full).map_err(|e| ParamError::Invalid(e.to_string()))?;
+            BodyEvaluation::Table(Arc::new(t))
+        }
+        "approx" => match &ndf {
+            Some(n) => {
+                let lobe = SpecularLobe::new(n.clone(), masking, sampling)?;
+                BodyEvaluation::Approx(Arc::new(IlApprox::new(&lobe, ni)?))
+            }
+            // Flat IL is closed-form already.
+            None => BodyEvaluation::Stochastic,
+        },
+        other => return Err(choice("evaluation", other, BodyEvaluation::NAMES)),
+    };
+    if samples.is_some() && !matches!(evaluation, BodyEvaluation::Quadrature { .. }) {
+        return Err(ParamError::Invalid("`samples` applies to evaluation = \"quadrature\"".into()));
+    }
+    if table_path.is_some() && !matches!(evaluation, BodyEvaluation::Table(_)) {
+        return Err(ParamError::Invalid("`table` applies to evaluation = \"table\"".into()));
+    }
+    p.finish(&keys(&["kd", "ni", "evaluation", "samples", "table", "scattering"], true))?;
+    let lobe = match ndf {
+        Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
+        None => None,
+    };
+    Ok(Arc::new(InterfacedLambertian::new(kd, ni, lobe, evaluation, scattering)?))
 }
 
 fn build_kelemen(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {

@@ -293,30 +293,20 @@ fn albedo_check(bsdf: &dyn Bsdf, wo: Vec3, label: &str, opts: &BsdfCheckOptions)
 }
 
 fn reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
+    if bsdf.is_stochastic() {
+        return statistical_reciprocity_check(bsdf, opts);
+    }
     let mut rng = Pcg32::new(mix_seed(opts.chi2.seed, 4242), 8);
     let transmissive = bsdf.flags().intersects(LobeFlags::TRANSMISSION);
     let mut worst_r: f64 = 0.0;
     let mut worst_t: f64 = 0.0;
     let mut worst_mode: f64 = 0.0;
     let seed = mix_seed(opts.chi2.seed, 17);
-    // Stochastic models get the same random numbers for both orders.
     let eval = |a: Vec3, b: Vec3, mode: TransportMode| {
         let mut r = Pcg32::new(seed, 1);
         bsdf.eval(a, b, &BsdfContext { mode }, &mut r)
     };
     let tol = opts.reciprocity_tol;
-    let err = |x: Spectrum, y: Spectrum| -> f64 {
-        (0..3)
-            .map(|c| {
-                let scale = x[c].abs().max(y[c].abs());
-                if scale < 1e-10 {
-                    0.0
-                } else {
-                    (x[c] - y[c]).abs() / scale
-                }
-            })
-            .fold(0.0, f64::max)
-    };
     for _ in 0..opts.reciprocity_pairs {
         let a = square_to_uniform_sphere(rng.next_2d());
         let mut b = square_to_uniform_sphere(rng.next_2d());
@@ -326,13 +316,13 @@ fn reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
         let fab = eval(a, b, TransportMode::Radiance);
         let fba = eval(b, a, TransportMode::Radiance);
         if a.z * b.z > 0.0 {
-            worst_r = worst_r.max(err(fab, fba));
+            worst_r = worst_r.max(spectrum_rel_err(fab, fba));
         } else {
             // eval_rad(a, b) = f(i=b, o=a): f(i,o)/η_o² = f(o,i)/η_i².
             let (na, nb) = (side_index(bsdf, a), side_index(bsdf, b));
-            worst_t = worst_t.max(err(fab / (na * na), fba / (nb * nb)));
+            worst_t = worst_t.max(spectrum_rel_err(fab / (na * na), fba / (nb * nb)));
             // Importance mode is the adjoint: eval_imp(b, a) = eval_rad(a, b).
-            worst_mode = worst_mode.max(err(fab, eval(b, a, TransportMode::Importance)));
+            worst_mode = worst_mode.max(spectrum_rel_err(fab, eval(b, a, TransportMode::Importance)));
         }
     }
     let ok = worst_r <= tol && worst_t <= tol && worst_mode <= 1e-12;
@@ -342,12 +332,72 @@ fn reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
             opts.reciprocity_pairs
         )
     } else {
-        format!(
-            "{} pairs: max relative error {worst_r:.1e} (tolerance {tol:.0e})",
-            opts.reciprocity_pairs
-        )
+        format!("{} pairs: max relative error {worst_r:.1e} (tolerance {tol:.0e})", opts.reciprocity_pairs)
     };
     Check::new(bsdf.describe(), "reciprocity", fig, Verdict::from_bool(ok))
+}
+
+/// Largest relative difference between two spectra over the channels (0 where both vanish).
+fn spectrum_rel_err(x: Spectrum, y: Spectrum) -> f64 {
+    (0..3)
+        .map(|c| {
+            let scale = x[c].abs().max(y[c].abs());
+            if scale < 1e-10 {
+                0.0
+            } else {
+                (x[c] - y[c]).abs() / scale
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Reciprocity of a stochastic model within Monte Carlo error: converged estimates of
+/// f(a, b) and f(b, a) must agree within 4 combined standard errors.
+fn statistical_reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
+    let pairs = 40usize;
+    let samples = 20_000usize;
+    let seed = mix_seed(opts.chi2.seed, 4343);
+    let results: Vec<(f64, f64)> = (0..pairs)
+        .into_par_iter()
+        .map(|k| {
+            let mut rng = Pcg32::new(mix_seed(seed, k as u64), 8);
+            let a = square_to_uniform_sphere(rng.next_2d());
+            let mut b = square_to_uniform_sphere(rng.next_2d());
+            if a.z * b.z < 0.0 {
+                b.z = -b.z;
+            }
+            let ctx = BsdfContext::RADIANCE;
+            let (fab, sab) = bsdf.eval_estimate(a, b, &ctx, samples, &mut rng);
+            let (fba, sba) = bsdf.eval_estimate(b, a, &ctx, samples, &mut rng);
+            let mut z: f64 = 0.0;
+            let mut rel: f64 = 0.0;
+            for c in 0..3 {
+                let se = (sab[c] * sab[c] + sba[c] * sba[c]).sqrt();
+                let d = (fab[c] - fba[c]).abs();
+                if se > 0.0 {
+                    z = z.max(d / se);
+                } else if d > 1e-12 {
+                    z = f64::INFINITY;
+                }
+                let scale = fab[c].abs().max(fba[c].abs());
+                if scale > 1e-10 {
+                    rel = rel.max(d / scale);
+                }
+            }
+            (z, rel)
+        })
+        .collect();
+    let worst_z = results.iter().map(|r| r.0).fold(0.0, f64::max);
+    let worst_rel = results.iter().map(|r| r.1).fold(0.0, f64::max);
+    // 40 pairs × 3 channels: 4 standard errors keeps the family-wise false alarm below 1 %.
+    Check::new(
+        bsdf.describe(),
+        "reciprocity within Monte Carlo error (stochastic model)",
+        format!(
+            "{pairs} pairs × {samples} estimates: max |f(a,b) − f(b,a)| = {worst_z:.2} standard errors (tolerance 4), max relative difference {worst_rel:.1e}"
+        ),
+        Verdict::from_bool(worst_z <= 4.0),
+    )
 }
 
 /// Directions that stress the code paths: poles, the tangent plane, just above and below it.

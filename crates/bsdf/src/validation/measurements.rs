@@ -21,16 +21,22 @@ pub struct OrenNayarError {
     pub worst: (f64, f64, f64),
 }
 
-/// Compares the two Oren–Nayar models over θ_i, θ_o ∈ {0, 10, …, 80}° and
+/// Compares Oren & Nayar's qualitative (or, with `l1`, L1) model with the exact one over
+/// θ_i, θ_o ∈ {0, 10, …, 80}° and
 /// Δφ ∈ {0, 45, 90, 135, 180}°, the exact one by quadrature with `samples` microfacets.
-pub fn oren_nayar_error(sigma: f64, samples: usize) -> OrenNayarError {
+pub fn oren_nayar_error(sigma: f64, samples: usize, l1: bool) -> OrenNayarError {
     let exact = OrenNayarExact::new(
         Spectrum::ONE,
         sigma,
         IntegralEvaluation::Quadrature { samples },
     )
     .expect("valid");
-    let approx = OrenNayarQualitative::new(Spectrum::ONE, sigma).expect("valid");
+    let approx = if l1 {
+        OrenNayarQualitative::l1(Spectrum::ONE, sigma)
+    } else {
+        OrenNayarQualitative::new(Spectrum::ONE, sigma)
+    }
+    .expect("valid");
     let mut cases = Vec::new();
     for ti in (0..=80).step_by(10) {
         for to in (0..=80).step_by(10) {
@@ -116,4 +122,22 @@ pub fn mean_weight(
             .map(|s| s.weight)
             .unwrap_or(Spectrum::ZERO)
     })
+}
+
+/// Hemispherical–hemispherical reflectance R = (1/π) ∫∫ f cos θ_i cos θ_o dω_i dω_o
+/// = 2 ∫_0^1 a(μ) μ dμ, with the directional albedo a(μ) from `samples` sampled weights at
+/// each of 8 Gauss–Legendre nodes in μ = cos θ: (R, standard error), green channel.
+pub fn hemispherical_reflectance(bsdf: &dyn Bsdf, samples: usize, seed: u64) -> (f64, f64) {
+    let gl = crate::math::quadrature::GaussLegendre::new(8);
+    let mut r = 0.0;
+    let mut var = 0.0;
+    for (k, (&x, &w)) in gl.nodes.iter().zip(&gl.weights).enumerate() {
+        let mu = 0.5 * (x + 1.0);
+        let wo = crate::math::Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+        let (a, se) = mean_weight(bsdf, wo, samples, mix_seed(seed, k as u64));
+        // ∫_0^1 g(μ) dμ = ½ Σ w_k g(μ_k);  R = 2 ∫ a μ dμ = Σ w_k a_k μ_k.
+        r += w * a[1] * mu;
+        var += (w * mu * se[1]).powi(2);
+    }
+    (r, var.sqrt())
 }

@@ -342,6 +342,18 @@ pub fn material_grid() -> Vec<&'static str> {
         r#"{type = "kelemen", distribution = "ward", alpha = 0.8, kd = [0.9, 0.5, 0.2], table_samples = 4096}"#,
         r#"{type = "kelemen", distribution = "beckmann", alpha = 0.3, table_samples = 4096}"#,
         r#"{type = "kelemen", distribution = "phong", exponent = 40, ior = 1.7, table_samples = 4096}"#,
+        r#"{type = "il", kd = 0.8, ni = 1.5, alpha = 0}"#,
+        r#"{type = "il", kd = [0.9, 0.5, 0.1], ni = 2.0, alpha = 0}"#,
+        r#"{type = "il", kd = 0.6, ni = 1.0, distribution = "gaussian", sigma = 0.5}"#,
+        r#"{type = "il", kd = 0.6, ni = 1.2, distribution = "gaussian", sigma = 0.05, evaluation = "quadrature", samples = 32}"#,
+        r#"{type = "il", kd = 0.9, ni = 1.5, distribution = "beckmann", alpha = 0.07}"#,
+        r#"{type = "il", kd = 0.5, ni = 2.0, distribution = "beckmann", alpha = 0.7, masking = "smith", evaluation = "quadrature", samples = 32}"#,
+        r#"{type = "il", kd = 0.7, ni = 1.5, distribution = "ggx", alpha = 1.0}"#,
+        r#"{type = "il", kd = 0.7, ni = 1.5, distribution = "ggx", alpha_u = 0.05, alpha_v = 0.4}"#,
+        r#"{type = "il", kd = 0.7, ni = 1.2, distribution = "beckmann", alpha_u = 0.6, alpha_v = 0.2, masking = "v-cavity"}"#,
+        r#"{type = "il", kd = 1.0, ni = 1.5, distribution = "beckmann", alpha = 0.5, scattering = "double"}"#,
+        r#"{type = "il", kd = [1.0, 0.6, 0.3], ni = 1.5, distribution = "beckmann", alpha = 1.0, scattering = "multiple"}"#,
+        r#"{type = "il", kd = 0.8, ni = 1.33, distribution = "gaussian", sigma = 0.3, scattering = "multiple"}"#,
     ]
 }
 

@@ -1,0 +1,393 @@
+//! The tabulated body term of interfaced Lambertian  [TSBRM §4.3].
+//!
+//! The body integral I(θ_i, θ_o, φ) = ∫ T(i,m) T(o,m) D(m) G(i,o,m) |i·m||o·m|/(|i·n||o·n|) dω_m
+//! (IL18 eq. 13 without its K_d/(π n_i² (1 − r_i K_d)) prefactor, so one table serves every
+//! K_d) is stored on a regular grid θ_i, θ_o ∈ [0°, 90°], φ = |φ_o − φ_i| ∈ [0°, 180°] (the
+//! integral of an isotropic distribution depends on the azimuth difference only and is even
+//! in it), and interpolated trilinearly — bilinear in (θ_o, φ), then linear in θ_i, as
+//! TSBRM Fig. 9. Anisotropic distributions would need φ_i as a fourth dimension; tables are
+//! refused for them.
+//!
+//! Entries are computed with the same N microfacet normals for the whole table (randomized
+//! QMC, 8 rotations of a Hammersley set drawn from the D(m)|m·n| sampler), so the table is
+//! smooth and each entry carries a standard error; only θ_i ≤ θ_o is computed, the rest by
+//! reciprocity.
+//!
+//! ## File format (`.fctab`, version 1, little-endian)
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `FCTBODY1` |
+//! | 4 | u32 format version (1) |
+//! | 4 | u32 length L of the header |
+//! | L | UTF-8 TOML header: `model = "il-body"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples`, `max_stderr` and `mean_stderr` (relative standard errors of the entries below the grazing row), `facette_version` |
+//! | 8·n_theta²·n_phi | f64 entries, θ_i-major, then θ_o, then φ |
+//! | 4 | u32 CRC-32 (IEEE) of all preceding bytes |
+
+use super::microfacet_integral::MicrofacetIntegral;
+use crate::error::{ParamError, ParamResult};
+use crate::fresnel::fresnel_dielectric;
+use crate::math::rng::{mix_seed, Pcg32, RandomSource};
+use crate::math::warp::hammersley;
+use crate::math::{fmt_num, spherical_direction, Vec3, PI};
+use crate::microfacet::specular_lobe::SpecularLobe;
+use crate::microfacet::Distribution;
+use rayon::prelude::*;
+
+const MAGIC: &[u8; 8] = b"FCTBODY1";
+const VERSION: u32 = 1;
+
+/// A tabulated IL body integral.
+#[derive(Clone, Debug)]
+pub struct BodyTable {
+    pub ni: f64,
+    /// `describe()` of the distribution it was built for.
+    pub distribution: String,
+    pub masking: String,
+    pub step_deg: f64,
+    pub n_theta: usize,
+    pub n_phi: usize,
+    pub samples: usize,
+    /// Largest and mean relative standard error of the entries below the grazing row.
+    pub max_stderr: f64,
+    pub mean_stderr: f64,
+    data: Vec<f64>,
+}
+
+/// Errors reading a table file.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    #[error("{path}: {reason}")]
+    Invalid { path: String, reason: String },
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl BodyTable {
+    /// Builds the table for the microfacet part of an IL material (the lobe's distribution
+    /// and masking) and index `ni`, with grid step `step_deg` (must divide 90) and `samples`
+    /// microfacets per entry. `progress(done, total)` is called as rows complete.
+    pub fn build(
+        lobe: &SpecularLobe,
+        ni: f64,
+        step_deg: f64,
+        samples: usize,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> ParamResult<BodyTable> {
+        if lobe.ndf.is_anisotropic() {
+            return Err(ParamError::Invalid(
+                "tables store (θ_i, θ_o, φ_o − φ_i) and need an isotropic distribution; \
+                 anisotropic IL uses evaluation = \"stochastic\" or \"quadrature\""
+                    .into(),
+            ));
+        }
+        let intervals = (90.0 / step_deg).round();
+        if !(step_deg > 0.0) || (intervals * step_deg - 90.0).abs() > 1e-9 || intervals < 1.0 {
+            return Err(ParamError::Invalid(format!(
+                "step = {step_deg}°: the grid step must divide 90° (e.g. 1, 2, 2.5, 5, 10)"
+            )));
+        }
+        if samples < 8 {
+            return Err(ParamError::OutOfRange {
+                name: "samples".into(),
+                value: samples as f64,
+                expected: "samples >= 8".into(),
+            });
+        }
+        let integral = MicrofacetIntegral::new(lobe.ndf.clone(), lobe.masking)?;
+        let n_theta = intervals as usize + 1;
+        let n_phi = 2 * intervals as usize + 1;
+        // The shared microfacet set: 8 rotations of a Hammersley set, with D cos / pdf.
+        const ROT: usize = 8;
+        let per = (samples / ROT).max(1) as u32;
+        let mut rng = Pcg32::new(mix_seed(0x7ab1e, samples as u64), 3);
+        let normals: Vec<Vec<(Vec3, f64)>> = (0..ROT)
+            .map(|_| {
+                let shift = rng.next_2d();
+                (0..per)
+                    .map(|k| {
+                        let m = integral.ndf.sample_normal(hammersley(k, per, shift));
+                        let p = integral.ndf.pdf_normal(m);
+                        let w = if p > 0.0 { integral.ndf.d(m) / p } else { 0.0 };
+                        (m, w)
+                    })
+                    .collect()
+            })
+            .collect();
+        let step = step_deg.to_radians();
+        let dir = |t: usize, p: usize| {
+            // Grazing nodes are evaluated just above the horizon, where the integral is
+            // continuous.
+            let th = (t as f64 * step).min(0.5 * PI - 1e-6);
+            spherical_direction(th, p as f64 * step)
+        };
+        let total_rows = n_theta;
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        // Row θ_i: entries (θ_o ≥ θ_i, φ) → (value, stderr).
+        let rows: Vec<Vec<(usize, usize, f64, f64)>> = (0..n_theta)
+            .into_par_iter()
+            .map(|ti| {
+                let i = dir(ti, 0);
+                let mut out = Vec::with_capacity((n_theta - ti) * n_phi);
+                // T(i·m) per normal, computed once for the row.
+                let ti_vals: Vec<Vec<f64>> = normals
+                    .iter()
+                    .map(|g| g.iter().map(|(m, _)| 1.0 - fresnel_dielectric(i.dot(*m).abs(), ni)).collect())
+                    .collect();
+                for to in ti..n_theta {
+                    for ph in 0..n_phi {
+                        let o = dir(to, ph);
+                        let mut means = [0.0; ROT];
+                        for (r, group) in normals.iter().enumerate() {
+                            let mut s = 0.0;
+                            for (k, &(m, w)) in group.iter().enumerate() {
+                                let im = i.dot(m);
+                                let om = o.dot(m);
+                                if im <= 0.0 || om <= 0.0 || w == 0.0 {
+                                    continue;
+                                }
+                                let g = integral.masking.g(&integral.ndf, i, o, m);
+                                if g == 0.0 {
+                                    continue;
+                                }
+                                let t_o = 1.0 - fresnel_dielectric(om, ni);
+                                s += ti_vals[r][k] * t_o * w * g * im * om;
+                            }
+                            means[r] = s / (per as f64 * i.z * o.z);
+                        }
+                        let mean = means.iter().sum::<f64>() / ROT as f64;
+                        let var = means.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (ROT as f64 - 1.0);
+                        out.push((to, ph, mean, (var / ROT as f64).sqrt()));
+                    }
+                }
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(d, total_rows);
+                out
+            })
+            .collect();
+        let mut data = vec![0.0; n_theta * n_theta * n_phi];
+        let (mut max_se, mut sum_se, mut count) = (0.0f64, 0.0, 0usize);
+        for (ti, row) in rows.into_iter().enumerate() {
+            for (to, ph, v, se) in row {
+                data[(ti * n_theta + to) * n_phi + ph] = v;
+                data[(to * n_theta + ti) * n_phi + ph] = v; // reciprocity
+                // Relative standard error, over the entries below the grazing row (where the
+                // integrand's 1/cos θ makes the estimate noisy but the interpolation weight
+                // of the node vanishes with cos θ).
+                if ti + 1 < n_theta && to + 1 < n_theta && v > 0.0 {
+                    let rel = se / v;
+                    max_se = max_se.max(rel);
+                    sum_se += rel;
+                    count += 1;
+                }
+            }
+        }
+        Ok(BodyTable {
+            ni,
+            distribution: lobe.ndf.describe(),
+            masking: lobe.masking.name().to_string(),
+            step_deg,
+            n_theta,
+            n_phi,
+            samples: per as usize * ROT,
+            max_stderr: max_se,
+            mean_stderr: sum_se / count.max(1) as f64,
+            data,
+        })
+    }
+
+    /// Trilinear lookup for an upper-hemisphere pair.
+    pub fn lookup(&self, i: Vec3, o: Vec3) -> f64 {
+        let step = self.step_deg.to_radians();
+        let ti = i.z.clamp(-1.0, 1.0).acos() / step;
+        let to = o.z.clamp(-1.0, 1.0).acos() / step;
+        let (si, so) = ((i.x * i.x + i.y * i.y).sqrt(), (o.x * o.x + o.y * o.y).sqrt());
+        let cos_dphi = if si > 1e-12 && so > 1e-12 {
+            ((i.x * o.x + i.y * o.y) / (si * so)).clamp(-1.0, 1.0)
+        } else {
+            1.0
+        };
+        let ph = cos_dphi.acos() / step;
+        let nt = (self.n_theta - 1) as f64;
+        let np = (self.n_phi - 1) as f64;
+        let (ti, to, ph) = (ti.clamp(0.0, nt), to.clamp(0.0, nt), ph.clamp(0.0, np));
+        let cell = |x: f64, n: usize| {
+            let k = (x.floor() as usize).min(n - 2);
+            (k, x - k as f64)
+        };
+        let (a, fa) = cell(ti, self.n_theta);
+        let (b, fb) = cell(to, self.n_theta);
+        let (c, fc) = cell(ph, self.n_phi);
+        let at = |x: usize, y: usize, z: usize| self.data[(x * self.n_theta + y) * self.n_phi + z];
+        let bilinear = |x: usize| {
+            let v0 = at(x, b, c) * (1.0 - fc) + at(x, b, c + 1) * fc;
+            let v1 = at(x, b + 1, c) * (1.0 - fc) + at(x, b + 1, c + 1) * fc;
+            v0 * (1.0 - fb) + v1 * fb
+        };
+        bilinear(a) * (1.0 - fa) + bilinear(a + 1) * fa
+    }
+
+    /// The table's grid values (θ_i-major, then θ_o, then φ).
+    pub fn values(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// Refuses a table built for other microfacet parameters.
+    pub fn check_matches(&self, ni: f64, lobe: &SpecularLobe) -> ParamResult<()> {
+        let d = lobe.ndf.describe();
+        let m = lobe.masking.name();
+        if (self.ni - ni).abs() > 1e-12 || self.distribution != d || self.masking != m {
+            return Err(ParamError::Invalid(format!(
+                "the table was built for ni = {}, {}, masking {}; this material has ni = {}, {}, masking {}",
+                fmt_num(self.ni),
+                self.distribution,
+                self.masking,
+                fmt_num(ni),
+                d,
+                m
+            )));
+        }
+        Ok(())
+    }
+
+    fn header(&self) -> String {
+        format!(
+            "model = \"il-body\"\nni = {}\ndistribution = \"{}\"\nmasking = \"{}\"\nstep_deg = {}\nn_theta = {}\nn_phi = {}\nsamples = {}\nmax_stderr = {:e}\nmean_stderr = {:e}\nfacette_version = \"{}\"\n",
+            self.ni,
+            self.distribution,
+            self.masking,
+            self.step_deg,
+            self.n_theta,
+            self.n_phi,
+            self.samples,
+            self.max_stderr,
+            self.mean_stderr,
+            env!("CARGO_PKG_VERSION")
+        )
+    }
+
+    /// Serializes to the documented binary format.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let header = self.header();
+        let mut out = Vec::with_capacity(20 + header.len() + 8 * self.data.len());
+        out.extend_from_slice(MAGIC);
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        out.extend_from_slice(header.as_bytes());
+        for v in &self.data {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        let crc = crc32fast::hash(&out);
+        out.extend_from_slice(&crc.to_le_bytes());
+        out
+    }
+
+    /// Parses the binary format; `path` names the source in errors.
+    pub fn from_bytes(bytes: &[u8], path: &str) -> Result<BodyTable, TableError> {
+        let bad = |reason: String| TableError::Invalid {
+            path: path.to_string(),
+            reason,
+        };
+        if bytes.len() < 20 || &bytes[..8] != MAGIC {
+            return Err(bad("not a facette IL body table (bad magic number)".into()));
+        }
+        let crc_stored = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().unwrap());
+        if crc32fast::hash(&bytes[..bytes.len() - 4]) != crc_stored {
+            return Err(bad("checksum mismatch: the file is corrupt or truncated".into()));
+        }
+        let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+        if version != VERSION {
+            return Err(bad(format!("format version {version} is not supported (expected {VERSION})")));
+        }
+        let hlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let body = bytes.len() - 4;
+        if 16 + hlen > body {
+            return Err(bad("header length exceeds the file".into()));
+        }
+        let header = std::str::from_utf8(&bytes[16..16 + hlen]).map_err(|_| bad("header is not UTF-8".into()))?;
+        let h: toml::Table = toml::from_str(header).map_err(|e| bad(format!("header: {}", e.message())))?;
+        let f = |k: &str| -> Result<f64, TableError> {
+            match h.get(k) {
+                Some(toml::Value::Float(x)) => Ok(*x),
+                Some(toml::Value::Integer(x)) => Ok(*x as f64),
+                _ => Err(bad(format!("header lacks number `{k}`"))),
+            }
+        };
+        let s = |k: &str| -> Result<String, TableError> {
+            match h.get(k) {
+                Some(toml::Value::String(x)) => Ok(x.clone()),
+                _ => Err(bad(format!("header lacks string `{k}`"))),
+            }
+        };
+        if s("model")? != "il-body" {
+            return Err(bad(format!("model `{}` is not an IL body table", s("model")?)));
+        }
+        let n_theta = f("n_theta")? as usize;
+        let n_phi = f("n_phi")? as usize;
+        if n_theta < 2 || n_phi < 2 || n_theta > 100_000 || n_phi > 100_000 {
+            return Err(bad(format!("implausible grid {n_theta} × {n_phi}")));
+        }
+        let count = n_theta * n_theta * n_phi;
+        let data_bytes = &bytes[16 + hlen..body];
+        if data_bytes.len() != 8 * count {
+            return Err(bad(format!(
+                "expected {} bytes of data for a {n_theta}×{n_theta}×{n_phi} grid, found {}",
+                8 * count,
+                data_bytes.len()
+            )));
+        }
+        let data: Vec<f64> = data_bytes
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        if data.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            return Err(bad("table contains negative or non-finite values".into()));
+        }
+        Ok(BodyTable {
+            ni: f("ni")?,
+            distribution: s("distribution")?,
+            masking: s("masking")?,
+            step_deg: f("step_deg")?,
+            n_theta,
+            n_phi,
+            samples: f("samples")? as usize,
+            max_stderr: f("max_stderr")?,
+            mean_stderr: f("mean_stderr")?,
+            data,
+        })
+    }
+
+    /// Reads a table file.
+    pub fn load(path: &std::path::Path) -> Result<BodyTable, TableError> {
+        let p = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| TableError::Io { path: p.clone(), source: e })?;
+        Self::from_bytes(&bytes, &p)
+    }
+
+    /// Writes the table atomically (temporary file in the same directory, then rename).
+    pub fn save(&self, path: &std::path::Path) -> Result<(), TableError> {
+        let p = path.display().to_string();
+        let io = |e: std::io::Error| TableError::Io { path: p.clone(), source: e };
+        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        let tmp = dir.join(format!(
+            ".{}.tmp-{}",
+            path.file_name().and_then(|n| n.to_str()).unwrap_or("table"),
+            std::process::id()
+        ));
+        let result = (|| {
+            use std::io::Write;
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(&self.to_bytes())?;
+            f.sync_all()?;
+            std::fs::rename(&tmp, path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        result.map_err(io)
+    }
+}
