@@ -143,8 +143,14 @@ fn il_tables(c: &mut Criterion) {
         g.bench_function(format!("step-{step}deg-10000-samples"), |b| {
             b.iter(|| {
                 black_box(
-                    facette_bsdf::models::il_table::BodyTable::build(&lobe, 1.2, step, 10_000, &|_, _| {})
-                        .unwrap(),
+                    facette_bsdf::models::il_table::BodyTable::build(
+                        &lobe,
+                        1.2,
+                        step,
+                        10_000,
+                        &|_, _| {},
+                    )
+                    .unwrap(),
                 )
             })
         });

@@ -9,7 +9,11 @@ fn main() {
     let re = facette_bsdf::fresnel::external_diffuse_reflectance(ni);
     let ri = facette_bsdf::fresnel::internal_diffuse_reflectance(ni);
     let kd = 1.0;
-    let facet = IlFacet { ni, kd: Spectrum::splat(kd), body_factor: Spectrum::splat(kd / (ni * ni * (1.0 - kd * ri))) };
+    let facet = IlFacet {
+        ni,
+        kd: Spectrum::splat(kd),
+        body_factor: Spectrum::splat(kd / (ni * ni * (1.0 - kd * ri))),
+    };
     let _ = re;
     for alpha in [0.1, 0.5, 1.0] {
         let d = Beckmann::isotropic(alpha).unwrap();
@@ -22,7 +26,13 @@ fn main() {
                 let m = d.sample_normal(rng.next_2d());
                 if let Some(w) = walk(&facet, m, i, &mut rng) {
                     let e = w.weight[0];
-                    if w.vertices == 1 { single += e } else if w.had_body_event { multi_body += e } else { multi_spec += e }
+                    if w.vertices == 1 {
+                        single += e
+                    } else if w.had_body_event {
+                        multi_body += e
+                    } else {
+                        multi_spec += e
+                    }
                 }
             }
             let nf = n as f64;

@@ -29,7 +29,11 @@ fn smooth_albedo(b: &dyn Bsdf, wo: Vec3) -> f64 {
         let mu = 0.5 * (x + 1.0);
         for (&y, &wy) in gl.nodes.iter().zip(&gl.weights) {
             let phi = std::f64::consts::PI * (y + 1.0);
-            let wi = Vec3::new((1.0 - mu * mu).sqrt() * phi.cos(), (1.0 - mu * mu).sqrt() * phi.sin(), mu);
+            let wi = Vec3::new(
+                (1.0 - mu * mu).sqrt() * phi.cos(),
+                (1.0 - mu * mu).sqrt() * phi.sin(),
+                mu,
+            );
             s += 0.5 * wx * std::f64::consts::PI * wy * eval(b, wo, wi)[1] * mu;
         }
     }
@@ -62,10 +66,15 @@ fn rough_il_loses_energy_in_single_scattering_and_multiple_scattering_restores_i
         ));
         let (r1, s1) = hemispherical_reflectance(single.as_ref(), 100_000, 3);
         let (rm, sm) = hemispherical_reflectance(multiple.as_ref(), 100_000, 4);
-        lines.push(format!("alpha {alpha}: single {r1:.4} ± {s1:.4}, multiple {rm:.4} ± {sm:.4}"));
+        lines.push(format!(
+            "alpha {alpha}: single {r1:.4} ± {s1:.4}, multiple {rm:.4} ± {sm:.4}"
+        ));
         assert!((rm - 1.0).abs() < 0.03, "IL_∞ at alpha {alpha}: {rm}");
         if alpha == 1.0 {
-            assert!(r1 < 0.8, "single scattering at alpha 1 must lose more than 20 %: {r1}");
+            assert!(
+                r1 < 0.8,
+                "single scattering at alpha 1 must lose more than 20 %: {r1}"
+            );
         }
         assert!(r1 <= 1.0 + 3.0 * s1 && rm <= 1.0 + 3.0 * sm);
     }
@@ -75,39 +84,58 @@ fn rough_il_loses_energy_in_single_scattering_and_multiple_scattering_restores_i
 #[test]
 fn zero_substrate_is_the_rough_specular_lobe() {
     let il = material(r#"{type = "il", kd = 0, ni = 1.5, distribution = "ggx", alpha = 0.3}"#);
-    let metal = material(r#"{type = "conductor", distribution = "ggx", alpha = 0.3, eta = 1.5, k = 0}"#);
+    let metal =
+        material(r#"{type = "conductor", distribution = "ggx", alpha = 0.3, eta = 1.5, k = 0}"#);
     for (a, b) in [(0.3, 0.9), (1.2, 0.1), (0.7, 0.7)] {
         let wo = spherical_direction(a, 0.2);
         let wi = spherical_direction(b, 3.0);
         let (x, y) = (eval(il.as_ref(), wo, wi), eval(metal.as_ref(), wo, wi));
-        assert!((x[0] - y[0]).abs() <= 1e-12 * y[0].max(1.0), "{x:?} vs {y:?}");
+        assert!(
+            (x[0] - y[0]).abs() <= 1e-12 * y[0].max(1.0),
+            "{x:?} vs {y:?}"
+        );
     }
 }
 
 #[test]
 fn unit_index_is_the_exact_oren_nayar_model() {
-    let il = material(r#"{type = "il", kd = 0.7, ni = 1.0, distribution = "gaussian", sigma = 0.4, evaluation = "quadrature", samples = 65536}"#);
+    let il = material(
+        r#"{type = "il", kd = 0.7, ni = 1.0, distribution = "gaussian", sigma = 0.4, evaluation = "quadrature", samples = 65536}"#,
+    );
     let on = material(r#"{type = "oren-nayar", reflectance = 0.7, sigma = 0.4, samples = 65536}"#);
-    for (a, b, p) in [(0.3, 0.9, 0.5), (1.2, 0.4, 3.0), (0.7, 1.3, 0.1), (1.4, 1.4, 0.0)] {
+    for (a, b, p) in [
+        (0.3, 0.9, 0.5),
+        (1.2, 0.4, 3.0),
+        (0.7, 1.3, 0.1),
+        (1.4, 1.4, 0.0),
+    ] {
         let wo = spherical_direction(a, p);
         let wi = spherical_direction(b, 0.0);
         let ctx = BsdfContext::RADIANCE;
         let (x, sx) = il.eval_estimate(wo, wi, &ctx, 0, &mut Pcg32::new(1, 1));
         let (y, sy) = on.eval_estimate(wo, wi, &ctx, 0, &mut Pcg32::new(1, 1));
         let se = (sx[0] * sx[0] + sy[0] * sy[0]).sqrt();
-        assert!((x[0] - y[0]).abs() <= 4.0 * se + 1e-9, "{x:?} ± {sx:?} vs {y:?} ± {sy:?}");
+        assert!(
+            (x[0] - y[0]).abs() <= 4.0 * se + 1e-9,
+            "{x:?} ± {sx:?} vs {y:?} ± {sy:?}"
+        );
     }
 }
 
 #[test]
 fn vanishing_roughness_tends_to_flat_il() {
     let flat = material(r#"{type = "il", kd = 0.8, ni = 1.5, alpha = 0}"#);
-    let rough = material(r#"{type = "il", kd = 0.8, ni = 1.5, distribution = "beckmann", alpha = 0.005, evaluation = "quadrature", samples = 4096}"#);
+    let rough = material(
+        r#"{type = "il", kd = 0.8, ni = 1.5, distribution = "beckmann", alpha = 0.005, evaluation = "quadrature", samples = 4096}"#,
+    );
     // Away from the specular peak the rough model is its body term.
     for (a, b) in [(0.3, 0.9), (1.0, 0.2), (0.5, 1.2)] {
         let wo = spherical_direction(a, 0.0);
         let wi = spherical_direction(b, 2.0);
-        let (x, y) = (eval(rough.as_ref(), wo, wi)[1], eval(flat.as_ref(), wo, wi)[1]);
+        let (x, y) = (
+            eval(rough.as_ref(), wo, wi)[1],
+            eval(flat.as_ref(), wo, wi)[1],
+        );
         assert!((x - y).abs() < 2e-3 * y, "{x} vs {y}");
     }
 }
@@ -115,10 +143,17 @@ fn vanishing_roughness_tends_to_flat_il() {
 #[test]
 fn multiple_scattering_orders_are_ordered() {
     // f₁ ≤ f₂ ≤ f_∞ (IL18 Fig. 9), estimated with many walks.
-    let base = "kd = 0.9, ni = 1.5, distribution = \"beckmann\", alpha = 0.8, masking = \"v-cavity\"";
-    let one = material(&format!("{{type = \"il\", {base}, evaluation = \"quadrature\", samples = 8192}}"));
-    let two = material(&format!("{{type = \"il\", {base}, scattering = \"double\"}}"));
-    let inf = material(&format!("{{type = \"il\", {base}, scattering = \"multiple\"}}"));
+    let base =
+        "kd = 0.9, ni = 1.5, distribution = \"beckmann\", alpha = 0.8, masking = \"v-cavity\"";
+    let one = material(&format!(
+        "{{type = \"il\", {base}, evaluation = \"quadrature\", samples = 8192}}"
+    ));
+    let two = material(&format!(
+        "{{type = \"il\", {base}, scattering = \"double\"}}"
+    ));
+    let inf = material(&format!(
+        "{{type = \"il\", {base}, scattering = \"multiple\"}}"
+    ));
     let wo = spherical_direction(1.0, 0.0);
     let wi = spherical_direction(0.6, 0.4);
     let ctx = BsdfContext::RADIANCE;
@@ -130,7 +165,12 @@ fn multiple_scattering_orders_are_ordered() {
 }
 
 fn gaussian_il_lobe(sigma: f64) -> SpecularLobe {
-    SpecularLobe::new(Ndf::Gaussian(Gaussian::new(sigma).unwrap()), Masking::VCavity, NormalSampling::Distribution).unwrap()
+    SpecularLobe::new(
+        Ndf::Gaussian(Gaussian::new(sigma).unwrap()),
+        Masking::VCavity,
+        NormalSampling::Distribution,
+    )
+    .unwrap()
 }
 
 #[test]
@@ -148,13 +188,22 @@ fn tables_interpolate_the_quadrature_and_round_trip_through_files() {
     let mut errors = Vec::new();
     for step in [10.0, 5.0] {
         let t = BodyTable::build(&lobe, 1.2, step, 4096, &|_, _| {}).unwrap();
-        let il = InterfacedLambertian::new(Spectrum::splat(0.9), 1.2, Some(lobe.clone()), BodyEvaluation::Table(Arc::new(t)), Scattering::Single).unwrap();
+        let il = InterfacedLambertian::new(
+            Spectrum::splat(0.9),
+            1.2,
+            Some(lobe.clone()),
+            BodyEvaluation::Table(Arc::new(t)),
+            Scattering::Single,
+        )
+        .unwrap();
         let mut rng = Pcg32::new(11, 0);
         let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0);
         use facette_bsdf::math::rng::RandomSource;
         for _ in 0..300 {
-            let wo = spherical_direction(rng.next_f64() * 1.4, rng.next_f64() * 6.28);
-            let wi = spherical_direction(rng.next_f64() * 1.4, rng.next_f64() * 6.28);
+            let wo =
+                spherical_direction(rng.next_f64() * 1.4, rng.next_f64() * std::f64::consts::TAU);
+            let wi =
+                spherical_direction(rng.next_f64() * 1.4, rng.next_f64() * std::f64::consts::TAU);
             let (a, _) = il.body_integral(wi, wo, 0, &mut rng);
             let (b, _) = quad.body_integral(wi, wo, 0, &mut rng);
             let e = ((a - b) / b).abs();
@@ -166,7 +215,10 @@ fn tables_interpolate_the_quadrature_and_round_trip_through_files() {
     }
     println!("table vs quadrature (θ ≤ 80°): {errors:?}");
     assert!(errors[0].1 < 0.02 && errors[1].1 < 0.01, "{errors:?}");
-    assert!(errors[1].1 < errors[0].1, "a 5° table must beat a 10° table");
+    assert!(
+        errors[1].1 < errors[0].1,
+        "a 5° table must beat a 10° table"
+    );
 
     // File round trip, and corrupted files are clear errors.
     let t = BodyTable::build(&lobe, 1.2, 10.0, 256, &|_, _| {}).unwrap();
@@ -179,11 +231,17 @@ fn tables_interpolate_the_quadrature_and_round_trip_through_files() {
     let mut bytes = std::fs::read(&p).unwrap();
     let mid = bytes.len() / 2;
     bytes[mid] ^= 0x55;
-    let e = BodyTable::from_bytes(&bytes, "x.fctab").unwrap_err().to_string();
+    let e = BodyTable::from_bytes(&bytes, "x.fctab")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("checksum"), "{e}");
-    let e = BodyTable::from_bytes(&bytes[..40], "x.fctab").unwrap_err().to_string();
+    let e = BodyTable::from_bytes(&bytes[..40], "x.fctab")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("checksum") || e.contains("magic"), "{e}");
-    let e = BodyTable::from_bytes(b"not a table at all, just text", "x.fctab").unwrap_err().to_string();
+    let e = BodyTable::from_bytes(b"not a table at all, just text", "x.fctab")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("bad magic"), "{e}");
     // A table for other parameters is refused by the material.
     let e = material_err(&format!("{{type = \"il\", kd = 0.5, ni = 1.5, distribution = \"gaussian\", sigma = 0.3, table = \"{}\"}}", p.display()));
@@ -195,7 +253,9 @@ fn tables_interpolate_the_quadrature_and_round_trip_through_files() {
         NormalSampling::Distribution,
     )
     .unwrap();
-    let e = BodyTable::build(&aniso, 1.5, 10.0, 64, &|_, _| {}).unwrap_err().to_string();
+    let e = BodyTable::build(&aniso, 1.5, 10.0, 64, &|_, _| {})
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("isotropic"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -213,11 +273,26 @@ fn bad_parameters_are_clear_errors() {
         (r#"{type = "il", kd = 1.2, alpha = 0.1}"#, "kd"),
         (r#"{type = "il", ni = 0.9, alpha = 0.1}"#, "ni"),
         (r#"{type = "il", ni = nan, alpha = 0.1}"#, "finite"),
-        (r#"{type = "il", alpha = 0.1, distribution = "cauchy"}"#, "beckmann, ggx, gaussian, phong"),
-        (r#"{type = "il", alpha = 0.1, masking = "smith", scattering = "multiple"}"#, "v-cavity"),
-        (r#"{type = "il", alpha = 0.1, scattering = "infinite"}"#, "single, double, multiple"),
-        (r#"{type = "il", alpha = 0.1, evaluation = "table"}"#, "missing required key `table"),
-        (r#"{type = "il", alpha = 0.1, table = "/nonexistent.fctab"}"#, "/nonexistent.fctab"),
+        (
+            r#"{type = "il", alpha = 0.1, distribution = "cauchy"}"#,
+            "beckmann, ggx, gaussian, phong",
+        ),
+        (
+            r#"{type = "il", alpha = 0.1, masking = "smith", scattering = "multiple"}"#,
+            "v-cavity",
+        ),
+        (
+            r#"{type = "il", alpha = 0.1, scattering = "infinite"}"#,
+            "single, double, multiple",
+        ),
+        (
+            r#"{type = "il", alpha = 0.1, evaluation = "table"}"#,
+            "missing required key `table",
+        ),
+        (
+            r#"{type = "il", alpha = 0.1, table = "/nonexistent.fctab"}"#,
+            "/nonexistent.fctab",
+        ),
     ] {
         let e = material_err(s);
         assert!(e.contains(needle), "{s}: {e}");
@@ -242,7 +317,9 @@ fn approximation_has_the_exact_limits_and_bounded_error() {
         }
     }
     // n_i = 1 with the Gaussian: Oren & Nayar's L1 model.
-    let il = material(r#"{type = "il", kd = 0.7, ni = 1.0, distribution = "gaussian", sigma = 0.45, evaluation = "approx"}"#);
+    let il = material(
+        r#"{type = "il", kd = 0.7, ni = 1.0, distribution = "gaussian", sigma = 0.45, evaluation = "approx"}"#,
+    );
     for (x, y, p) in [(0.2, 0.7, 0.3), (1.1, 0.4, 2.5), (1.3, 1.2, 0.0)] {
         let (wi, wo) = (spherical_direction(x, 0.0), spherical_direction(y, p));
         let f = il.eval(wo, wi, &BsdfContext::RADIANCE, &mut rng)[0];
@@ -250,26 +327,46 @@ fn approximation_has_the_exact_limits_and_bounded_error() {
         assert!((f - on).abs() < 1e-12, "{f} vs {on}");
     }
     // Accuracy against the quadrature at one interior point of each V-cavity family.
-    for (fam, bound) in [(ApproxFamily::GaussianVCavity, 0.12), (ApproxFamily::BeckmannVCavity, 0.12)] {
+    for (fam, bound) in [
+        (ApproxFamily::GaussianVCavity, 0.12),
+        (ApproxFamily::BeckmannVCavity, 0.12),
+    ] {
         let e = facette_lab_free_accuracy(fam, 0.35, 1.5);
-        println!("{}: σ = 0.35, n_i = 1.5: mean relative error {e:.4}", fam.name());
+        println!(
+            "{}: σ = 0.35, n_i = 1.5: mean relative error {e:.4}",
+            fam.name()
+        );
         assert!(e < bound, "{e}");
     }
 }
 
 /// Mean relative error of the approximation against the quadrature over θ ≤ 75°.
-fn facette_lab_free_accuracy(fam: facette_bsdf::models::il_approx::ApproxFamily, sigma: f64, ni: f64) -> f64 {
+fn facette_lab_free_accuracy(
+    fam: facette_bsdf::models::il_approx::ApproxFamily,
+    sigma: f64,
+    ni: f64,
+) -> f64 {
     use facette_bsdf::models::il_approx::{ApproxFamily, IlApprox};
     let lobe = match fam {
         ApproxFamily::GaussianVCavity => gaussian_il_lobe(sigma),
         _ => SpecularLobe::new(
-            Ndf::Beckmann(facette_bsdf::microfacet::Beckmann::isotropic(std::f64::consts::SQRT_2 * sigma).unwrap()),
+            Ndf::Beckmann(
+                facette_bsdf::microfacet::Beckmann::isotropic(std::f64::consts::SQRT_2 * sigma)
+                    .unwrap(),
+            ),
             Masking::VCavity,
             NormalSampling::Distribution,
         )
         .unwrap(),
     };
-    let quad = InterfacedLambertian::new(Spectrum::ONE, ni, Some(lobe), BodyEvaluation::Quadrature { samples: 16384 }, Scattering::Single).unwrap();
+    let quad = InterfacedLambertian::new(
+        Spectrum::ONE,
+        ni,
+        Some(lobe),
+        BodyEvaluation::Quadrature { samples: 16384 },
+        Scattering::Single,
+    )
+    .unwrap();
     let approx = IlApprox::for_family(fam, sigma, ni).unwrap();
     let re = facette_bsdf::fresnel::external_diffuse_reflectance(ni);
     let mut rng = Pcg32::new(1, 1);

@@ -44,13 +44,23 @@ pub fn run(a: IlApproxArgs) -> Result<ExitCode> {
                     pb.set_position(d as u64);
                 });
                 pb.finish_and_clear();
-                let worst = f.nodes.iter().flatten().map(|n| n.mean_rel).fold(0.0, f64::max);
-                eprintln!("{}: fitted, worst node mean relative error {:.3}", fam.name(), worst);
+                let worst = f
+                    .nodes
+                    .iter()
+                    .flatten()
+                    .map(|n| n.mean_rel)
+                    .fold(0.0, f64::max);
+                eprintln!(
+                    "{}: fitted, worst node mean relative error {:.3}",
+                    fam.name(),
+                    worst
+                );
                 fits.push(f);
             }
             let src = coefficients_source(&fits, samples);
             match output {
-                Some(p) => std::fs::write(&p, src).with_context(|| format!("cannot write {}", p.display()))?,
+                Some(p) => std::fs::write(&p, src)
+                    .with_context(|| format!("cannot write {}", p.display()))?,
                 None => print!("{src}"),
             }
         }
@@ -61,13 +71,24 @@ pub fn run(a: IlApproxArgs) -> Result<ExitCode> {
                 for sigma in [0.1, 0.25, 0.5, 0.9, 1.3] {
                     for ni in [1.0, 1.25, 1.5, 2.2, 3.0] {
                         let e = accuracy(fam, sigma, ni, samples);
-                        println!("{},{sigma},{ni},{:.4},{:.4},{:.4}", fam.name(), e.mean, e.p95, e.max);
+                        println!(
+                            "{},{sigma},{ni},{:.4},{:.4},{:.4}",
+                            fam.name(),
+                            e.mean,
+                            e.p95,
+                            e.max
+                        );
                         sum += e.mean;
                         n += 1;
                         max = max.max(e.max);
                     }
                 }
-                println!("# {}: mean relative error {:.4}, max {:.4}", fam.name(), sum / n as f64, max);
+                println!(
+                    "# {}: mean relative error {:.4}, max {:.4}",
+                    fam.name(),
+                    sum / n as f64,
+                    max
+                );
             }
         }
     }

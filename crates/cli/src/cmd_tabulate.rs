@@ -44,7 +44,9 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
     // Rebuild the concrete model to reach its microfacet lobe.
     let il = match (bsdf.describe(), find_il(&table)?) {
         (_, Some(il)) => il,
-        (d, None) => bail!("--material: {d} is flat (alpha = 0): its body term is closed-form and needs no table"),
+        (d, None) => bail!(
+            "--material: {d} is flat (alpha = 0): its body term is closed-form and needs no table"
+        ),
     };
     let lobe = il.lobe().expect("rough").clone();
     let pb = crate::progress::bar(0, "tabulating");
@@ -56,7 +58,8 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
     .context("tabulate")?;
     pb.finish_and_clear();
     let secs = start.elapsed().as_secs_f64();
-    t.save(&a.output).with_context(|| format!("cannot write {}", a.output.display()))?;
+    t.save(&a.output)
+        .with_context(|| format!("cannot write {}", a.output.display()))?;
     println!(
         "wrote {} ({}×{}×{} entries, {} samples each, {:.2} s; relative standard error of the entries with θ < 90°: mean {:.2e}, max {:.2e})",
         a.output.display(),
@@ -76,12 +79,24 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
             BodyEvaluation::Quadrature { samples: 65536 },
             Scattering::Single,
         )?;
-        let tab = InterfacedLambertian::new(il.kd(), il.ni(), Some(lobe), BodyEvaluation::Table(Arc::new(t)), Scattering::Single)?;
+        let tab = InterfacedLambertian::new(
+            il.kd(),
+            il.ni(),
+            Some(lobe),
+            BodyEvaluation::Table(Arc::new(t)),
+            Scattering::Single,
+        )?;
         let mut rng = Pcg32::new(17, 0);
         let (mut sum, mut max) = (0.0f64, 0.0f64);
         for _ in 0..a.check {
-            let wi = spherical_direction(rng.next_f64() * 80f64.to_radians(), rng.next_f64() * std::f64::consts::TAU);
-            let wo = spherical_direction(rng.next_f64() * 80f64.to_radians(), rng.next_f64() * std::f64::consts::TAU);
+            let wi = spherical_direction(
+                rng.next_f64() * 80f64.to_radians(),
+                rng.next_f64() * std::f64::consts::TAU,
+            );
+            let wo = spherical_direction(
+                rng.next_f64() * 80f64.to_radians(),
+                rng.next_f64() * std::f64::consts::TAU,
+            );
             let (x, _) = tab.body_integral(wi, wo, 0, &mut rng);
             let (y, _) = quad.body_integral(wi, wo, 0, &mut rng);
             let e = ((x - y) / y).abs();
@@ -103,7 +118,9 @@ fn find_il(table: &toml::Table) -> Result<Option<InterfacedLambertian>> {
     use facette_bsdf::microfacet::specular_lobe::SpecularLobe;
     use facette_bsdf::spec::microfacet::{parse_distribution, parse_masking, parse_sampling};
     let p = Params::new(table, "material \"il\"");
-    let kd = p.spectrum("kd")?.unwrap_or(facette_bsdf::Spectrum::splat(0.5));
+    let kd = p
+        .spectrum("kd")?
+        .unwrap_or(facette_bsdf::Spectrum::splat(0.5));
     let ni = p.f64_or("ni", 1.5)?;
     let Some(ndf) = parse_distribution(&p, true)? else {
         return Ok(None);

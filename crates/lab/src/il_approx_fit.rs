@@ -18,7 +18,9 @@ use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::{spherical_direction, Vec3};
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Gaussian, Masking, Ndf};
-use facette_bsdf::models::il_approx::{approx_integral, ApproxCoefficients, ApproxFamily, IlApprox};
+use facette_bsdf::models::il_approx::{
+    approx_integral, ApproxCoefficients, ApproxFamily, IlApprox,
+};
 use facette_bsdf::models::il_approx_coefficients::{NI_NODES, SIGMA_NODES};
 use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
@@ -48,13 +50,20 @@ pub struct FamilyFit {
 /// The microfacet lobe of a family at Gaussian-equivalent roughness σ.
 pub fn lobe_for(family: ApproxFamily, sigma: f64) -> SpecularLobe {
     let (ndf, masking) = match family {
-        ApproxFamily::GaussianVCavity => (Ndf::Gaussian(Gaussian::new(sigma).expect("σ in range")), Masking::VCavity),
+        ApproxFamily::GaussianVCavity => (
+            Ndf::Gaussian(Gaussian::new(sigma).expect("σ in range")),
+            Masking::VCavity,
+        ),
         ApproxFamily::BeckmannVCavity => (
-            Ndf::Beckmann(Beckmann::isotropic(std::f64::consts::SQRT_2 * sigma).expect("α in range")),
+            Ndf::Beckmann(
+                Beckmann::isotropic(std::f64::consts::SQRT_2 * sigma).expect("α in range"),
+            ),
             Masking::VCavity,
         ),
         ApproxFamily::BeckmannSmith => (
-            Ndf::Beckmann(Beckmann::isotropic(std::f64::consts::SQRT_2 * sigma).expect("α in range")),
+            Ndf::Beckmann(
+                Beckmann::isotropic(std::f64::consts::SQRT_2 * sigma).expect("α in range"),
+            ),
             Masking::SmithSeparable,
         ),
     };
@@ -67,7 +76,10 @@ pub fn direction_grid(thetas: &[f64], phis: &[f64]) -> Vec<(Vec3, Vec3)> {
     for &ti in thetas {
         for &to in thetas {
             for &p in phis {
-                v.push((spherical_direction(ti.to_radians(), 0.0), spherical_direction(to.to_radians(), p.to_radians())));
+                v.push((
+                    spherical_direction(ti.to_radians(), 0.0),
+                    spherical_direction(to.to_radians(), p.to_radians()),
+                ));
             }
         }
     }
@@ -81,7 +93,13 @@ pub fn fit_directions() -> Vec<(Vec3, Vec3)> {
 }
 
 /// Quadrature body integrals of a family at (σ, n_i) on `dirs`.
-pub fn exact_integrals(family: ApproxFamily, sigma: f64, ni: f64, dirs: &[(Vec3, Vec3)], samples: usize) -> Vec<f64> {
+pub fn exact_integrals(
+    family: ApproxFamily,
+    sigma: f64,
+    ni: f64,
+    dirs: &[(Vec3, Vec3)],
+    samples: usize,
+) -> Vec<f64> {
     let il = InterfacedLambertian::new(
         Spectrum::splat(0.5),
         ni,
@@ -91,10 +109,18 @@ pub fn exact_integrals(family: ApproxFamily, sigma: f64, ni: f64, dirs: &[(Vec3,
     )
     .expect("valid material");
     let mut rng = Pcg32::new(1, 1);
-    dirs.iter().map(|&(i, o)| il.body_integral(i, o, 0, &mut rng).0).collect()
+    dirs.iter()
+        .map(|&(i, o)| il.body_integral(i, o, 0, &mut rng).0)
+        .collect()
 }
 
-fn rel_errors(c: &ApproxCoefficients, dirs: &[(Vec3, Vec3)], exact: &[f64], ni: f64, re: f64) -> (f64, f64) {
+fn rel_errors(
+    c: &ApproxCoefficients,
+    dirs: &[(Vec3, Vec3)],
+    exact: &[f64],
+    ni: f64,
+    re: f64,
+) -> (f64, f64) {
     let mut sum = 0.0;
     let mut max: f64 = 0.0;
     let mut n = 0usize;
@@ -111,7 +137,11 @@ fn rel_errors(c: &ApproxCoefficients, dirs: &[(Vec3, Vec3)], exact: &[f64], ni: 
 }
 
 /// Fits one family over the whole grid. `progress(done, total)` counts nodes.
-pub fn fit_family(family: ApproxFamily, samples: usize, progress: &(dyn Fn(usize, usize) + Sync)) -> FamilyFit {
+pub fn fit_family(
+    family: ApproxFamily,
+    samples: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> FamilyFit {
     let dirs = fit_directions();
     let total = SIGMA_NODES.len() * NI_NODES.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
@@ -121,7 +151,13 @@ pub fn fit_family(family: ApproxFamily, samples: usize, progress: &(dyn Fn(usize
             if sigma == 0.0 {
                 let nodes = NI_NODES
                     .iter()
-                    .map(|&ni| NodeFit { sigma, ni, params: [1.0, 0.0, 0.0], mean_rel: 0.0, max_rel: 0.0 })
+                    .map(|&ni| NodeFit {
+                        sigma,
+                        ni,
+                        params: [1.0, 0.0, 0.0],
+                        mean_rel: 0.0,
+                        max_rel: 0.0,
+                    })
                     .collect();
                 done.fetch_add(NI_NODES.len(), std::sync::atomic::Ordering::Relaxed);
                 return (nodes, [1.0, 1.0, 1.0]);
@@ -132,7 +168,13 @@ pub fn fit_family(family: ApproxFamily, samples: usize, progress: &(dyn Fn(usize
                 ApproxFamily::GaussianVCavity => [1.0, 1.0, 1.0],
                 _ => {
                     let fit = minimize(&[1.0, 1.0, 1.0], |p| {
-                        let c = ApproxCoefficients { sigma, a: 1.0, b: 0.0, k: 0.0, on: [p[0], p[1], p[2]] };
+                        let c = ApproxCoefficients {
+                            sigma,
+                            a: 1.0,
+                            b: 0.0,
+                            k: 0.0,
+                            on: [p[0], p[1], p[2]],
+                        };
                         log_residuals(&c, &dirs, &lambertian, 1.0, 0.0)
                     });
                     [fit.params[0], fit.params[1], fit.params[2]]
@@ -142,21 +184,43 @@ pub fn fit_family(family: ApproxFamily, samples: usize, progress: &(dyn Fn(usize
                 .iter()
                 .map(|&ni| {
                     let re = external_diffuse_reflectance(ni);
-                    let exact = if ni == 1.0 { lambertian.clone() } else { exact_integrals(family, sigma, ni, &dirs, samples) };
+                    let exact = if ni == 1.0 {
+                        lambertian.clone()
+                    } else {
+                        exact_integrals(family, sigma, ni, &dirs, samples)
+                    };
                     let params = if ni == 1.0 {
                         [1.0, 0.0, 0.0]
                     } else {
                         let fit = minimize(&[1.0, 0.0, 0.0], |p| {
-                            let c = ApproxCoefficients { sigma, a: p[0], b: p[1], k: p[2], on };
+                            let c = ApproxCoefficients {
+                                sigma,
+                                a: p[0],
+                                b: p[1],
+                                k: p[2],
+                                on,
+                            };
                             log_residuals(&c, &dirs, &exact, ni, re)
                         });
                         [fit.params[0], fit.params[1], fit.params[2]]
                     };
-                    let c = ApproxCoefficients { sigma, a: params[0], b: params[1], k: params[2], on };
+                    let c = ApproxCoefficients {
+                        sigma,
+                        a: params[0],
+                        b: params[1],
+                        k: params[2],
+                        on,
+                    };
                     let (mean_rel, max_rel) = rel_errors(&c, &dirs, &exact, ni, re);
                     let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress(d, total);
-                    NodeFit { sigma, ni, params, mean_rel, max_rel }
+                    NodeFit {
+                        sigma,
+                        ni,
+                        params,
+                        mean_rel,
+                        max_rel,
+                    }
                 })
                 .collect();
             (nodes, on)
@@ -169,7 +233,13 @@ pub fn fit_family(family: ApproxFamily, samples: usize, progress: &(dyn Fn(usize
     }
 }
 
-fn log_residuals(c: &ApproxCoefficients, dirs: &[(Vec3, Vec3)], exact: &[f64], ni: f64, re: f64) -> Vec<f64> {
+fn log_residuals(
+    c: &ApproxCoefficients,
+    dirs: &[(Vec3, Vec3)],
+    exact: &[f64],
+    ni: f64,
+    re: f64,
+) -> Vec<f64> {
     dirs.iter()
         .zip(exact)
         .map(|(&(i, o), &e)| {
@@ -191,7 +261,12 @@ pub fn coefficients_source(fits: &[FamilyFit], samples: usize) -> String {
             s += "    [";
             s += &row
                 .iter()
-                .map(|n| format!("[{:.8}, {:.8}, {:.8}]", n.params[0], n.params[1], n.params[2]))
+                .map(|n| {
+                    format!(
+                        "[{:.8}, {:.8}, {:.8}]",
+                        n.params[0], n.params[1], n.params[2]
+                    )
+                })
                 .collect::<Vec<_>>()
                 .join(", ");
             s += "],\n";
@@ -205,8 +280,16 @@ pub fn coefficients_source(fits: &[FamilyFit], samples: usize) -> String {
         }
         s + "]"
     };
-    let get = |fam: ApproxFamily| fits.iter().find(|f| f.family == fam).expect("all families fitted");
-    let (g, bv, bs) = (get(ApproxFamily::GaussianVCavity), get(ApproxFamily::BeckmannVCavity), get(ApproxFamily::BeckmannSmith));
+    let get = |fam: ApproxFamily| {
+        fits.iter()
+            .find(|f| f.family == fam)
+            .expect("all families fitted")
+    };
+    let (g, bv, bs) = (
+        get(ApproxFamily::GaussianVCavity),
+        get(ApproxFamily::BeckmannVCavity),
+        get(ApproxFamily::BeckmannSmith),
+    );
     let (ns, nn) = (SIGMA_NODES.len(), NI_NODES.len());
     format!(
         "//! Fitted coefficients of the approximate IL body term (see `il_approx`). GENERATED by\n\

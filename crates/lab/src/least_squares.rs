@@ -84,9 +84,15 @@ mod tests {
         let xs: Vec<f64> = (0..40).map(|k| k as f64 * 0.1).collect();
         let ys: Vec<f64> = xs.iter().map(|x| 2.5 * (-1.3 * x).exp() + 0.2).collect();
         let out = minimize(&[1.0, -0.5, 0.0], |p| {
-            xs.iter().zip(&ys).map(|(x, y)| p[0] * (p[1] * x).exp() + p[2] - y).collect()
+            xs.iter()
+                .zip(&ys)
+                .map(|(x, y)| p[0] * (p[1] * x).exp() + p[2] - y)
+                .collect()
         });
         assert!(out.converged);
-        assert!((out.params[0] - 2.5).abs() < 1e-6 && (out.params[1] + 1.3).abs() < 1e-6, "{out:?}");
+        assert!(
+            (out.params[0] - 2.5).abs() < 1e-6 && (out.params[1] + 1.3).abs() < 1e-6,
+            "{out:?}"
+        );
     }
 }

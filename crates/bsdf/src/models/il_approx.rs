@@ -83,7 +83,10 @@ pub struct ApproxCoefficients {
 pub fn approx_integral(c: &ApproxCoefficients, i: Vec3, o: Vec3, ni: f64, re: f64) -> f64 {
     let t01 = 1.0 - re;
     let tbar = |u: Vec3| c.a * (1.0 - fresnel_dielectric(u.z, ni)) + c.b * t01;
-    let (si, so) = ((1.0 - i.z * i.z).max(0.0).sqrt(), (1.0 - o.z * o.z).max(0.0).sqrt());
+    let (si, so) = (
+        (1.0 - i.z * i.z).max(0.0).sqrt(),
+        (1.0 - o.z * o.z).max(0.0).sqrt(),
+    );
     let cos_dphi = if si > 1e-12 && so > 1e-12 {
         ((i.x * o.x + i.y * o.y) / (si * so)).clamp(-1.0, 1.0)
     } else {

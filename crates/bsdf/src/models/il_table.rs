@@ -136,7 +136,11 @@ impl BodyTable {
                 // T(i·m) per normal, computed once for the row.
                 let ti_vals: Vec<Vec<f64>> = normals
                     .iter()
-                    .map(|g| g.iter().map(|(m, _)| 1.0 - fresnel_dielectric(i.dot(*m).abs(), ni)).collect())
+                    .map(|g| {
+                        g.iter()
+                            .map(|(m, _)| 1.0 - fresnel_dielectric(i.dot(*m).abs(), ni))
+                            .collect()
+                    })
                     .collect();
                 for to in ti..n_theta {
                     for ph in 0..n_phi {
@@ -160,7 +164,8 @@ impl BodyTable {
                             means[r] = s / (per as f64 * i.z * o.z);
                         }
                         let mean = means.iter().sum::<f64>() / ROT as f64;
-                        let var = means.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (ROT as f64 - 1.0);
+                        let var = means.iter().map(|x| (x - mean).powi(2)).sum::<f64>()
+                            / (ROT as f64 - 1.0);
                         out.push((to, ph, mean, (var / ROT as f64).sqrt()));
                     }
                 }
@@ -175,9 +180,9 @@ impl BodyTable {
             for (to, ph, v, se) in row {
                 data[(ti * n_theta + to) * n_phi + ph] = v;
                 data[(to * n_theta + ti) * n_phi + ph] = v; // reciprocity
-                // Relative standard error, over the entries below the grazing row (where the
-                // integrand's 1/cos θ makes the estimate noisy but the interpolation weight
-                // of the node vanishes with cos θ).
+                                                            // Relative standard error, over the entries below the grazing row (where the
+                                                            // integrand's 1/cos θ makes the estimate noisy but the interpolation weight
+                                                            // of the node vanishes with cos θ).
                 if ti + 1 < n_theta && to + 1 < n_theta && v > 0.0 {
                     let rel = se / v;
                     max_se = max_se.max(rel);
@@ -205,7 +210,10 @@ impl BodyTable {
         let step = self.step_deg.to_radians();
         let ti = i.z.clamp(-1.0, 1.0).acos() / step;
         let to = o.z.clamp(-1.0, 1.0).acos() / step;
-        let (si, so) = ((i.x * i.x + i.y * i.y).sqrt(), (o.x * o.x + o.y * o.y).sqrt());
+        let (si, so) = (
+            (i.x * i.x + i.y * i.y).sqrt(),
+            (o.x * o.x + o.y * o.y).sqrt(),
+        );
         let cos_dphi = if si > 1e-12 && so > 1e-12 {
             ((i.x * o.x + i.y * o.y) / (si * so)).clamp(-1.0, 1.0)
         } else {
@@ -297,19 +305,25 @@ impl BodyTable {
         }
         let crc_stored = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().unwrap());
         if crc32fast::hash(&bytes[..bytes.len() - 4]) != crc_stored {
-            return Err(bad("checksum mismatch: the file is corrupt or truncated".into()));
+            return Err(bad(
+                "checksum mismatch: the file is corrupt or truncated".into()
+            ));
         }
         let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
         if version != VERSION {
-            return Err(bad(format!("format version {version} is not supported (expected {VERSION})")));
+            return Err(bad(format!(
+                "format version {version} is not supported (expected {VERSION})"
+            )));
         }
         let hlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
         let body = bytes.len() - 4;
         if 16 + hlen > body {
             return Err(bad("header length exceeds the file".into()));
         }
-        let header = std::str::from_utf8(&bytes[16..16 + hlen]).map_err(|_| bad("header is not UTF-8".into()))?;
-        let h: toml::Table = toml::from_str(header).map_err(|e| bad(format!("header: {}", e.message())))?;
+        let header = std::str::from_utf8(&bytes[16..16 + hlen])
+            .map_err(|_| bad("header is not UTF-8".into()))?;
+        let h: toml::Table =
+            toml::from_str(header).map_err(|e| bad(format!("header: {}", e.message())))?;
         let f = |k: &str| -> Result<f64, TableError> {
             match h.get(k) {
                 Some(toml::Value::Float(x)) => Ok(*x),
@@ -324,7 +338,10 @@ impl BodyTable {
             }
         };
         if s("model")? != "il-body" {
-            return Err(bad(format!("model `{}` is not an IL body table", s("model")?)));
+            return Err(bad(format!(
+                "model `{}` is not an IL body table",
+                s("model")?
+            )));
         }
         let n_theta = f("n_theta")? as usize;
         let n_phi = f("n_phi")? as usize;
@@ -364,15 +381,24 @@ impl BodyTable {
     /// Reads a table file.
     pub fn load(path: &std::path::Path) -> Result<BodyTable, TableError> {
         let p = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| TableError::Io { path: p.clone(), source: e })?;
+        let bytes = std::fs::read(path).map_err(|e| TableError::Io {
+            path: p.clone(),
+            source: e,
+        })?;
         Self::from_bytes(&bytes, &p)
     }
 
     /// Writes the table atomically (temporary file in the same directory, then rename).
     pub fn save(&self, path: &std::path::Path) -> Result<(), TableError> {
         let p = path.display().to_string();
-        let io = |e: std::io::Error| TableError::Io { path: p.clone(), source: e };
-        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        let io = |e: std::io::Error| TableError::Io {
+            path: p.clone(),
+            source: e,
+        };
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
         let tmp = dir.join(format!(
             ".{}.tmp-{}",
             path.file_name().and_then(|n| n.to_str()).unwrap_or("table"),

@@ -39,7 +39,9 @@ use super::vcavity::{self, IlFacet, Orders};
 use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{check_range, Bounds, ParamError, ParamResult};
-use crate::fresnel::{external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance};
+use crate::fresnel::{
+    external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance,
+};
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
@@ -231,19 +233,27 @@ impl InterfacedLambertian {
     /// The body integral I(i, o) = ∫ T T D G |im||om|/(|in||on|) dω (IL18 eq. 13 without its
     /// prefactor) by the model's evaluation mode, with its standard error where known.
     /// `samples` > 0 asks stochastic evaluation for an average of that many estimates.
-    pub fn body_integral(&self, i: Vec3, o: Vec3, samples: usize, rng: &mut dyn RandomSource) -> (f64, f64) {
+    pub fn body_integral(
+        &self,
+        i: Vec3,
+        o: Vec3,
+        samples: usize,
+        rng: &mut dyn RandomSource,
+    ) -> (f64, f64) {
         let Some(integral) = &self.integral else {
             // Flat: D is a delta at n.
             return (self.transmittance(i.z) * self.transmittance(o.z), 0.0);
         };
         let h = |m: Vec3| self.transmittance(i.dot(m)) * self.transmittance(o.dot(m));
         match &self.evaluation {
-            BodyEvaluation::Stochastic if samples <= 1 => (integral.estimate_one(i, o, rng.next_2d(), h), 0.0),
+            BodyEvaluation::Stochastic if samples <= 1 => {
+                (integral.estimate_one(i, o, rng.next_2d(), h), 0.0)
+            }
             BodyEvaluation::Stochastic => {
                 // Independent one-microfacet estimates: their standard error has many degrees
                 // of freedom (the 8-rotation QMC error of `estimate` is too noisy for tests).
                 let (m, se) = crate::bsdf::mean_and_stderr(samples, || {
-                    Spectrum::splat(integral.estimate_one(i, o, rng.next_2d(), &h))
+                    Spectrum::splat(integral.estimate_one(i, o, rng.next_2d(), h))
                 });
                 (m[0], se[0])
             }
@@ -256,7 +266,13 @@ impl InterfacedLambertian {
     }
 
     /// f_s + f_b (single scattering) for the upper-hemisphere pair (o, i).
-    fn single(&self, o: Vec3, i: Vec3, samples: usize, rng: &mut dyn RandomSource) -> (Spectrum, Spectrum) {
+    fn single(
+        &self,
+        o: Vec3,
+        i: Vec3,
+        samples: usize,
+        rng: &mut dyn RandomSource,
+    ) -> (Spectrum, Spectrum) {
         let spec = match &self.lobe {
             Some(l) => l.eval(o, i, |c| Spectrum::splat(fresnel_dielectric(c, self.ni))),
             None => Spectrum::ZERO,
@@ -309,7 +325,8 @@ impl Bsdf for InterfacedLambertian {
 
     fn is_stochastic(&self) -> bool {
         self.lobe.is_some()
-            && (matches!(self.evaluation, BodyEvaluation::Stochastic) || self.scattering != Scattering::Single)
+            && (matches!(self.evaluation, BodyEvaluation::Stochastic)
+                || self.scattering != Scattering::Single)
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
@@ -344,7 +361,12 @@ impl Bsdf for InterfacedLambertian {
         (single + ms, se)
     }
 
-    fn sample(&self, wo: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
+    fn sample(
+        &self,
+        wo: Vec3,
+        ctx: &BsdfContext,
+        rng: &mut dyn RandomSource,
+    ) -> Option<BsdfSample> {
         if wo.z == 0.0 {
             return None;
         }
@@ -376,7 +398,10 @@ impl Bsdf for InterfacedLambertian {
             });
         };
         let (i, lobe_flag) = if choose_specular {
-            (lobe.sample(o, rng.next_2d())?.0, LobeFlags::GLOSSY_REFLECTION)
+            (
+                lobe.sample(o, rng.next_2d())?.0,
+                LobeFlags::GLOSSY_REFLECTION,
+            )
         } else {
             let (wi, _) = sample_cosine_same_side(o, rng)?;
             (wi, LobeFlags::DIFFUSE_REFLECTION)

@@ -201,7 +201,10 @@ pub fn oren_nayar_l1_factor(sigma: f64, c: [f64; 3], i: Vec3, o: Vec3) -> f64 {
     let s2 = sigma * sigma;
     let (ti, to) = (i.z.clamp(-1.0, 1.0).acos(), o.z.clamp(-1.0, 1.0).acos());
     let (alpha, beta) = (ti.max(to), ti.min(to));
-    let (si, so) = ((1.0 - i.z * i.z).max(0.0).sqrt(), (1.0 - o.z * o.z).max(0.0).sqrt());
+    let (si, so) = (
+        (1.0 - i.z * i.z).max(0.0).sqrt(),
+        (1.0 - o.z * o.z).max(0.0).sqrt(),
+    );
     let cos_dphi = if si > 1e-12 && so > 1e-12 {
         ((i.x * o.x + i.y * o.y) / (si * so)).clamp(-1.0, 1.0)
     } else {

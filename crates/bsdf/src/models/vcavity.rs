@@ -55,7 +55,8 @@ impl IlFacet {
     /// Body BRDF of the facet [IL18 eq. 9]: T(i,m) T(o,m) K_d/(π n_i² (1 − K_d r_i)).
     #[inline]
     pub fn body(&self, cos_i: f64, cos_o: f64) -> Spectrum {
-        self.body_factor * (self.transmittance(cos_i) * self.transmittance(cos_o) * crate::math::INV_PI)
+        self.body_factor
+            * (self.transmittance(cos_i) * self.transmittance(cos_o) * crate::math::INV_PI)
     }
 }
 
@@ -123,7 +124,11 @@ impl Groove {
                 continue;
             }
             let x = p.0 + s * vx;
-            let inside = if k == 0 { (-1.0 - 1e-9..=1e-9).contains(&x) } else { (-1e-9..=1.0 + 1e-9).contains(&x) };
+            let inside = if k == 0 {
+                (-1.0 - 1e-9..=1e-9).contains(&x)
+            } else {
+                (-1e-9..=1.0 + 1e-9).contains(&x)
+            };
             if inside && s < best.0 {
                 best = (s, Next::Facet(k, (x, p.1 + s * vy)));
             }
@@ -203,7 +208,11 @@ pub fn estimate(
             Orders::Second => 2usize.saturating_sub(vertex),
             _ => MAX_CHAIN,
         };
-        let min_j = if vertex == 1 && orders != Orders::All { 1 } else { 0 };
+        let min_j = if vertex == 1 && orders != Orders::All {
+            1
+        } else {
+            0
+        };
         if min_j <= max_j {
             for j in min_j..=max_j {
                 if let Some((q, fres)) = chain(&g, k, p, o, j, facet.ni) {

@@ -48,7 +48,10 @@ pub fn build_material(table: &toml::Table) -> ParamResult<Arc<dyn Bsdf>> {
 
 /// Builds the BSDF described by `table`, resolving relative file paths against `base_dir`
 /// (a scene file's directory).
-pub fn build_material_in(table: &toml::Table, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>> {
+pub fn build_material_in(
+    table: &toml::Table,
+    base_dir: &std::path::Path,
+) -> ParamResult<Arc<dyn Bsdf>> {
     let ty = match table.get("type") {
         Some(toml::Value::String(s)) => s.as_str(),
         Some(_) => return Err(ParamError::Invalid("`type` must be a string".into())),
@@ -310,7 +313,11 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>
     };
     let samples = p.usize("samples")?;
     let table_path = p.str("table")?;
-    let evaluation = match p.str("evaluation")?.unwrap_or(if table_path.is_some() { "table" } else { "stochastic" }) {
+    let evaluation = match p.str("evaluation")?.unwrap_or(if table_path.is_some() {
+        "table"
+    } else {
+        "stochastic"
+    }) {
         "stochastic" => BodyEvaluation::Stochastic,
         "quadrature" => BodyEvaluation::Quadrature {
             samples: samples.unwrap_or(1024),
@@ -335,17 +342,26 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>
         other => return Err(choice("evaluation", other, BodyEvaluation::NAMES)),
     };
     if samples.is_some() && !matches!(evaluation, BodyEvaluation::Quadrature { .. }) {
-        return Err(ParamError::Invalid("`samples` applies to evaluation = \"quadrature\"".into()));
+        return Err(ParamError::Invalid(
+            "`samples` applies to evaluation = \"quadrature\"".into(),
+        ));
     }
     if table_path.is_some() && !matches!(evaluation, BodyEvaluation::Table(_)) {
-        return Err(ParamError::Invalid("`table` applies to evaluation = \"table\"".into()));
+        return Err(ParamError::Invalid(
+            "`table` applies to evaluation = \"table\"".into(),
+        ));
     }
-    p.finish(&keys(&["kd", "ni", "evaluation", "samples", "table", "scattering"], true))?;
+    p.finish(&keys(
+        &["kd", "ni", "evaluation", "samples", "table", "scattering"],
+        true,
+    ))?;
     let lobe = match ndf {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
     };
-    Ok(Arc::new(InterfacedLambertian::new(kd, ni, lobe, evaluation, scattering)?))
+    Ok(Arc::new(InterfacedLambertian::new(
+        kd, ni, lobe, evaluation, scattering,
+    )?))
 }
 
 fn build_kelemen(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {

@@ -322,7 +322,8 @@ fn reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
             let (na, nb) = (side_index(bsdf, a), side_index(bsdf, b));
             worst_t = worst_t.max(spectrum_rel_err(fab / (na * na), fba / (nb * nb)));
             // Importance mode is the adjoint: eval_imp(b, a) = eval_rad(a, b).
-            worst_mode = worst_mode.max(spectrum_rel_err(fab, eval(b, a, TransportMode::Importance)));
+            worst_mode =
+                worst_mode.max(spectrum_rel_err(fab, eval(b, a, TransportMode::Importance)));
         }
     }
     let ok = worst_r <= tol && worst_t <= tol && worst_mode <= 1e-12;
@@ -332,7 +333,10 @@ fn reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
             opts.reciprocity_pairs
         )
     } else {
-        format!("{} pairs: max relative error {worst_r:.1e} (tolerance {tol:.0e})", opts.reciprocity_pairs)
+        format!(
+            "{} pairs: max relative error {worst_r:.1e} (tolerance {tol:.0e})",
+            opts.reciprocity_pairs
+        )
     };
     Check::new(bsdf.describe(), "reciprocity", fig, Verdict::from_bool(ok))
 }
