@@ -101,9 +101,9 @@ fn png_bit_depths_and_layouts() {
     write_png_raw(&p, 2, 1, &bytes, image::ExtendedColorType::Rgb16);
     let lin = read_image(&p, ColorEncoding::Linear).unwrap();
     let srgb = read_image(&p, ColorEncoding::Srgb).unwrap();
-    for k in 0..6 {
+    for (k, &code) in codes.iter().enumerate() {
         let (x, c) = (k / 3, k % 3);
-        let v = codes[k] as f64 / 65535.0;
+        let v = code as f64 / 65535.0;
         assert!((lin.get(x, 0)[c] as f64 - v).abs() < 1e-7);
         assert!((srgb.get(x, 0)[c] as f64 - srgb_to_linear(v)).abs() < 1e-7);
     }
@@ -266,6 +266,44 @@ fn missing_corrupt_and_truncated_files_are_errors() {
             // A decoder may accept scrambled payload; what it returns must be finite.
             assert!(read.is_finite());
         }
+    }
+}
+
+/// Overwrites the four i32 of the `dataWindow` box of an EXR file.
+fn patch_data_window(bytes: &mut [u8], window: [i32; 4]) {
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("dataWindow attribute")
+        + key.len()
+        + 4; // attribute size
+    for (k, v) in window.iter().enumerate() {
+        bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&v.to_le_bytes());
+    }
+}
+
+#[test]
+fn a_damaged_exr_header_is_an_error_not_an_allocation() {
+    // `exr` sizes its buffers from the header: a huge data window must be rejected before
+    // decoding (an attempt to allocate would abort the process, not return an error).
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.exr");
+    write_image(&good, &random_image(4, 4, 9, 1.0), 0.0).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let bad = dir.path().join("bad.exr");
+    for window in [
+        [0, 0, 200_000, 200_000],
+        [0, 0, 9_999, 9_999],
+        [0, 0, 3, 70_000],
+    ] {
+        let mut b = bytes.clone();
+        patch_data_window(&mut b, window);
+        std::fs::write(&bad, &b).unwrap();
+        let err = read_image(&bad, ColorEncoding::Linear).unwrap_err();
+        assert_error_names(&err, &bad);
+        let err = read_exr_channels(&bad).unwrap_err();
+        assert_error_names(&err, &bad);
     }
 }
 

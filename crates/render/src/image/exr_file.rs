@@ -155,6 +155,7 @@ type FlatLayer = Layer<AnyChannels<FlatSamples>>;
 /// leftover bytes in compressed blocks, so a damaged file could come back with silently
 /// zeroed or garbled blocks instead of an error.
 fn read_layers(path: &Path) -> Result<Image<Layers<AnyChannels<FlatSamples>>>, ImageError> {
+    check_header_plausible(path)?;
     // `catch_unwind` is a last line of defence: a malformed file must never bring down a
     // render, even through a bug in a dependency's decoder.
     let result = std::panic::catch_unwind(|| {
@@ -176,6 +177,74 @@ fn read_layers(path: &Path) -> Result<Image<Layers<AnyChannels<FlatSamples>>>, I
             reason: "the decoder failed on malformed data".into(),
         }),
     }
+}
+
+/// Largest layer read, in pixels (2²⁸: 16k × 16k).
+pub(crate) const MAX_PIXELS: usize = 1 << 28;
+/// Largest number of samples (pixels × channels, all layers) read: 4 GiB as f32.
+const MAX_SAMPLES: usize = 1 << 30;
+
+/// Reads the headers alone and rejects sizes no genuine file of this length can have,
+/// before the decoder allocates the pixel buffers: `exr` sizes them from the header, so a
+/// damaged data window would otherwise ask for hundreds of gigabytes and abort the process.
+fn check_header_plausible(path: &Path) -> Result<(), ImageError> {
+    let meta = std::panic::catch_unwind(|| exr::meta::MetaData::read_from_file(path, false));
+    let meta = match meta {
+        Ok(Ok(m)) => m,
+        Ok(Err(e)) => return Err(read_error(path, e)),
+        Err(_) => {
+            return Err(ImageError::Corrupt {
+                path: path.to_path_buf(),
+                format: FORMAT,
+                reason: "the header is malformed".into(),
+            })
+        }
+    };
+    let file_len = std::fs::metadata(path)
+        .map_err(|source| ImageError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .len();
+    let mut chunks: u64 = 0;
+    let mut samples: usize = 0;
+    for header in meta.headers.iter() {
+        let (w, h) = (header.layer_size.width(), header.layer_size.height());
+        if w.checked_mul(h).is_none_or(|n| n > MAX_PIXELS) {
+            return Err(ImageError::Unsupported {
+                path: path.to_path_buf(),
+                format: FORMAT,
+                reason: format!(
+                    "a {w}×{h} layer exceeds the limit of {MAX_PIXELS} pixels (or the header \
+                     is damaged)"
+                ),
+            });
+        }
+        chunks = chunks.saturating_add(header.chunk_count as u64);
+        samples = samples.saturating_add((w * h).saturating_mul(header.channels.list.len()));
+    }
+    if samples > MAX_SAMPLES {
+        return Err(ImageError::Unsupported {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            reason: format!(
+                "{samples} samples in all exceed the limit of {MAX_SAMPLES} (or the header \
+                 is damaged)"
+            ),
+        });
+    }
+    // Every chunk has an 8-byte entry in the offset table and at least 8 bytes of its own.
+    if chunks.saturating_mul(16) > file_len {
+        return Err(ImageError::Corrupt {
+            path: path.to_path_buf(),
+            format: FORMAT,
+            reason: format!(
+                "the file is truncated: its header announces {chunks} pixel blocks, which \
+                 cannot fit in {file_len} bytes"
+            ),
+        });
+    }
+    Ok(())
 }
 
 fn samples_to_f32(s: &FlatSamples) -> Vec<f32> {
