@@ -101,7 +101,6 @@ pub(crate) fn write_atomically(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::io::Write as _;
 
     fn leftovers(dir: &Path) -> Vec<String> {
         std::fs::read_dir(dir)
