@@ -18,17 +18,25 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod atomic_write;
+pub mod constant_environment;
+pub mod distribution_2d;
+pub mod environment;
 pub mod error;
 mod exr_file;
 pub mod io;
 pub mod mipmap;
 pub mod rgb_image;
+pub mod sky;
 pub mod srgb;
 pub mod texture;
 
+pub use constant_environment::ConstantEnvironment;
+pub use distribution_2d::Distribution2D;
+pub use environment::{EnvSample, EnvironmentMap};
 pub use error::ImageError;
 pub use exr_file::{read_exr_channels, write_exr_channels, ExrChannels};
 pub use io::{read_image, write_image, ColorEncoding};
 pub use mipmap::{MipMap, WrapMode};
 pub use rgb_image::RgbImage;
+pub use sky::{ensure_sky, generate_sky, SkyParams};
 pub use texture::Texture;
