@@ -234,16 +234,18 @@ impl EnvironmentMap {
     /// Radiance arriving along world direction `d` (bilinear, times `scale`); black for a
     /// degenerate `d`.
     pub fn eval(&self, d: DVec3) -> Spectrum {
-        let Some(uv) = self.uv(d) else {
-            return Spectrum::ZERO;
-        };
+        self.uv(d).map_or(Spectrum::ZERO, |uv| self.eval_uv(uv))
+    }
+
+    /// Radiance at texture coordinates `uv` ∈ [0, 1)² (bilinear, times `scale`).
+    fn eval_uv(&self, uv: DVec2) -> Spectrum {
         let (w, h) = (self.image.width(), self.image.height());
         let x = uv.x * w as f64 - 0.5;
         let y = uv.y * h as f64 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let xa = (x0 as i64).rem_euclid(w as i64) as usize;
-        let xb = (xa + 1) % w;
+        let xb = if xa + 1 == w { 0 } else { xa + 1 };
         let ya = (y0 as i64).clamp(0, h as i64 - 1) as usize;
         let yb = (y0 as i64 + 1).clamp(0, h as i64 - 1) as usize;
         let top = self.pixel(xa, ya) * (1.0 - fx) + self.pixel(xb, ya) * fx;
@@ -253,9 +255,11 @@ impl EnvironmentMap {
 
     /// Density (per unit solid angle) with which [`EnvironmentMap::sample`] produces `d`.
     pub fn pdf(&self, d: DVec3) -> f64 {
-        let Some(uv) = self.uv(d) else {
-            return 0.0;
-        };
+        self.uv(d).map_or(0.0, |uv| self.pdf_uv(uv))
+    }
+
+    /// The density of the pixel holding `uv`: P(pixel) / Ω(pixel).
+    fn pdf_uv(&self, uv: DVec2) -> f64 {
         let (w, h) = (self.image.width(), self.image.height());
         let x = ((uv.x * w as f64) as usize).min(w - 1);
         let y = ((uv.y * h as f64) as usize).min(h - 1);
@@ -278,15 +282,17 @@ impl EnvironmentMap {
         let (sin_phi, cos_phi) = (TWO_PI * (x as f64 + f.x) / w).sin_cos();
         let local = DVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
         let direction = (self.to_world * local).normalize();
-        // Re-derive the density from the direction, so that it equals `pdf(direction)`
-        // even when rounding puts the direction on a neighbouring pixel's edge.
-        let pdf = self.pdf(direction);
+        // Re-derive uv from the direction, so that the density and radiance equal
+        // `pdf(direction)` and `eval(direction)` to the bit, even when rounding puts the
+        // direction on a neighbouring pixel's edge.
+        let uv = self.uv(direction)?;
+        let pdf = self.pdf_uv(uv);
         if !(pdf > 0.0) {
             return None;
         }
         Some(EnvSample {
             direction,
-            radiance: self.eval(direction),
+            radiance: self.eval_uv(uv),
             pdf,
         })
     }

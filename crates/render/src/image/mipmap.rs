@@ -56,6 +56,9 @@ impl WrapMode {
     #[inline]
     pub fn index(self, i: i64, n: usize) -> usize {
         let n = n as i64;
+        if (0..n).contains(&i) {
+            return i as usize;
+        }
         let k = match self {
             WrapMode::Repeat => i.rem_euclid(n),
             WrapMode::Clamp => i.clamp(0, n - 1),
