@@ -50,6 +50,14 @@ pub struct Kelemen {
     density: HalfVectorDensity,
     fresnel: Fresnel,
     kd: Spectrum,
+    /// The tables depend on the specular lobe only, so materials differing by k (a
+    /// textured matte colour) share them.
+    tables: std::sync::Arc<KelemenTables>,
+}
+
+/// Specular-albedo and matte-sampling tables.
+#[derive(Clone, Debug, Default)]
+struct KelemenTables {
     /// a_s(θ_k), θ_k = k·(π/2)/TABLE_INTERVALS, clamped to [0, 1].
     albedo: Vec<Spectrum>,
     albedo_stderr: f64,
@@ -79,18 +87,21 @@ impl Kelemen {
             density,
             fresnel,
             kd,
-            albedo: Vec::new(),
-            albedo_stderr: 0.0,
-            average: Spectrum::ZERO,
-            matte_cdf: Vec::new(),
-            matte_g: Vec::new(),
+            tables: Default::default(),
         };
-        k.build_tables(table_samples);
+        k.tables = std::sync::Arc::new(k.build_tables(table_samples));
         Ok(k)
     }
 
+    /// The same material with another matte colour k (the tables are shared).
+    pub fn with_kd(&self, kd: Spectrum) -> ParamResult<Self> {
+        check_spectrum("kd", kd, 0.0, 1.0)?;
+        Ok(Kelemen { kd, ..self.clone() })
+    }
+
     /// Builds a_s(θ) [KSK01 §2.1.5], its average and the matte sampling table.
-    fn build_tables(&mut self, samples: usize) {
+    fn build_tables(&self, samples: usize) -> KelemenTables {
+        let mut t = KelemenTables::default();
         use rayon::prelude::*;
         const ROT: usize = 8;
         let per = (samples / ROT).max(8) as u32;
@@ -123,51 +134,50 @@ impl Kelemen {
                 (mean, (var / ROT as f64).sqrt())
             })
             .collect();
-        self.albedo = rows
+        t.albedo = rows
             .iter()
             .map(|r| r.0.map(|v| v.clamp(0.0, 1.0)))
             .collect();
-        self.albedo_stderr = rows.iter().map(|r| r.1).fold(0.0, f64::max);
+        t.albedo_stderr = rows.iter().map(|r| r.1).fold(0.0, f64::max);
         // ā_s = 2 ∫ a_s(θ) cos θ sin θ dθ of the interpolated table, segment by segment.
         let gl = GaussLegendre::new(8);
         let mut avg = Spectrum::ZERO;
         for seg in 0..TABLE_INTERVALS {
             let (t0, t1) = (seg as f64 * step, (seg + 1) as f64 * step);
             for c in 0..crate::math::spectrum::CHANNELS {
-                avg[c] += 2.0 * gl.integrate(t0, t1, |t| self.albedo_at(t)[c] * t.cos() * t.sin());
+                avg[c] +=
+                    2.0 * gl.integrate(t0, t1, |x| albedo_in(&t.albedo, x)[c] * x.cos() * x.sin());
             }
         }
-        self.average = avg;
+        t.average = avg;
         // Matte sampling: g(θ) = (1 − ā_s(θ)) cos θ sin θ, piecewise linear on the grid.
-        self.matte_g = (0..=TABLE_INTERVALS)
+        t.matte_g = (0..=TABLE_INTERVALS)
             .map(|k| {
-                let t = k as f64 * step;
-                (1.0 - self.albedo[k].average()).max(0.0) * t.cos() * t.sin()
+                let x = k as f64 * step;
+                (1.0 - t.albedo[k].average()).max(0.0) * x.cos() * x.sin()
             })
             .collect();
         let mut cdf = vec![0.0; TABLE_INTERVALS + 1];
         for k in 0..TABLE_INTERVALS {
-            cdf[k + 1] = cdf[k] + 0.5 * (self.matte_g[k] + self.matte_g[k + 1]) * step;
+            cdf[k + 1] = cdf[k] + 0.5 * (t.matte_g[k] + t.matte_g[k + 1]) * step;
         }
-        self.matte_cdf = cdf;
+        t.matte_cdf = cdf;
+        t
     }
 
     /// Interpolated a_s(θ).
     pub fn albedo_at(&self, theta: f64) -> Spectrum {
-        let x = (theta / (0.5 * PI) * TABLE_INTERVALS as f64).clamp(0.0, TABLE_INTERVALS as f64);
-        let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
-        let t = x - k as f64;
-        self.albedo[k] * (1.0 - t) + self.albedo[k + 1] * t
+        albedo_in(&self.tables.albedo, theta)
     }
 
     /// The average specular albedo ā_s.
     pub fn average_albedo(&self) -> Spectrum {
-        self.average
+        self.tables.average
     }
 
     /// Largest standard error of the a_s table entries.
     pub fn albedo_table_stderr(&self) -> f64 {
-        self.albedo_stderr
+        self.tables.albedo_stderr
     }
 
     /// KSK01 §2.2.1's Russian-roulette probabilities for a path arriving along `wo`:
@@ -211,7 +221,7 @@ impl Kelemen {
     fn matte(&self, o: Vec3, i: Vec3) -> Spectrum {
         let ao = self.albedo_at(o.z.min(1.0).acos());
         let ai = self.albedo_at(i.z.min(1.0).acos());
-        let denom = Spectrum::ONE - self.average;
+        let denom = Spectrum::ONE - self.tables.average;
         let num = (Spectrum::ONE - ao) * (Spectrum::ONE - ai);
         self.kd * num.zip(denom, |n, d| if d > 0.0 { n / d } else { 0.0 }) / PI
     }
@@ -253,13 +263,13 @@ impl Kelemen {
         let x = (theta / step).clamp(0.0, TABLE_INTERVALS as f64);
         let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
         let t = x - k as f64;
-        let g = self.matte_g[k] * (1.0 - t) + self.matte_g[k + 1] * t;
-        let total = self.matte_cdf[TABLE_INTERVALS];
+        let g = self.tables.matte_g[k] * (1.0 - t) + self.tables.matte_g[k + 1] * t;
+        let total = self.tables.matte_cdf[TABLE_INTERVALS];
         let s = theta.sin();
         if total <= 0.0 || s <= 0.0 {
             // θ = 0 has measure zero; return the density's limit along the axis.
             return if total > 0.0 {
-                (1.0 - self.albedo[0].average()) / (TWO_PI * total)
+                (1.0 - self.tables.albedo[0].average()) / (TWO_PI * total)
             } else {
                 0.0
             };
@@ -268,19 +278,20 @@ impl Kelemen {
     }
 
     fn sample_matte(&self, u: crate::math::Vec2) -> Option<Vec3> {
-        let total = self.matte_cdf[TABLE_INTERVALS];
+        let tables = &self.tables;
+        let total = tables.matte_cdf[TABLE_INTERVALS];
         if total <= 0.0 {
             return None;
         }
         let target = u.x * total;
-        let k = match self.matte_cdf.binary_search_by(|c| c.total_cmp(&target)) {
+        let k = match tables.matte_cdf.binary_search_by(|c| c.total_cmp(&target)) {
             Ok(k) => k.min(TABLE_INTERVALS - 1),
             Err(k) => k.saturating_sub(1).min(TABLE_INTERVALS - 1),
         };
         let step = 0.5 * PI / TABLE_INTERVALS as f64;
         // Invert the quadratic cumulative of the linear g on [θ_k, θ_k+1].
-        let (g0, g1) = (self.matte_g[k], self.matte_g[k + 1]);
-        let r = target - self.matte_cdf[k];
+        let (g0, g1) = (tables.matte_g[k], tables.matte_g[k + 1]);
+        let r = target - tables.matte_cdf[k];
         let slope = (g1 - g0) / step;
         let dt = if slope.abs() < 1e-14 {
             if g0 > 0.0 {
@@ -380,6 +391,14 @@ impl Bsdf for Kelemen {
             self.fresnel
         )
     }
+}
+
+/// a_s(θ) linearly interpolated in `table`.
+fn albedo_in(table: &[Spectrum], theta: f64) -> Spectrum {
+    let x = (theta / (0.5 * PI) * TABLE_INTERVALS as f64).clamp(0.0, TABLE_INTERVALS as f64);
+    let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
+    let t = x - k as f64;
+    table[k] * (1.0 - t) + table[k + 1] * t
 }
 
 /// Validates a Kelemen Fresnel index.

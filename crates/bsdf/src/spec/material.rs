@@ -29,6 +29,7 @@ pub const MATERIAL_TYPES: &[&str] = &[
     "conductor",
     "dielectric",
     "kelemen",
+    "il",
 ];
 
 fn keys(extra: &[&'static str], micro: bool) -> Vec<&'static str> {
@@ -52,35 +53,320 @@ pub fn build_material_in(
     table: &toml::Table,
     base_dir: &std::path::Path,
 ) -> ParamResult<Arc<dyn Bsdf>> {
-    let ty = match table.get("type") {
-        Some(toml::Value::String(s)) => s.as_str(),
-        Some(_) => return Err(ParamError::Invalid("`type` must be a string".into())),
-        None => {
-            return Err(ParamError::MissingKey {
-                key: format!("type (one of: {})", MATERIAL_TYPES.join(", ")),
-                context: "material".into(),
-            })
+    MaterialRecipe::parse(table, base_dir)?.build()
+}
+
+/// Oren–Nayar variants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OrenNayarModel {
+    Exact,
+    Qualitative,
+    L1,
+}
+
+/// How an interfaced-Lambertian recipe evaluates its body term.
+#[derive(Clone, Debug)]
+pub enum IlEvaluation {
+    Stochastic,
+    Quadrature {
+        samples: usize,
+    },
+    Table(Arc<BodyTable>),
+    /// The approximation's coefficients are looked up at build time (they depend on the
+    /// roughness, which a texture may change).
+    Approx,
+}
+
+/// A validated material with its parameters as numbers: what a material table parses to,
+/// built into a BSDF by [`MaterialRecipe::build`]. The renderer keeps recipes of textured
+/// materials and overrides their textured parameters per shading point
+/// ([`set_spectrum`](Self::set_spectrum), [`set_scalar`](Self::set_scalar)) before building;
+/// expensive precomputations (Kelemen's albedo tables, IL body tables, the Gaussian's
+/// normalization table) are shared, not redone.
+#[derive(Clone, Debug)]
+pub enum MaterialRecipe {
+    Lambert {
+        reflectance: Spectrum,
+    },
+    OrenNayar {
+        reflectance: Spectrum,
+        sigma: f64,
+        model: OrenNayarModel,
+        evaluation: IntegralEvaluation,
+    },
+    Conductor {
+        lobe: Option<SpecularLobe>,
+        fresnel: Fresnel,
+        tint: Spectrum,
+    },
+    Dielectric {
+        lobe: Option<SpecularLobe>,
+        eta: f64,
+        widened: bool,
+        reflect_tint: Spectrum,
+        transmit_tint: Spectrum,
+    },
+    Kelemen(Arc<Kelemen>),
+    Il {
+        kd: Spectrum,
+        ni: f64,
+        lobe: Option<SpecularLobe>,
+        evaluation: IlEvaluation,
+        scattering: Scattering,
+    },
+}
+
+impl MaterialRecipe {
+    /// Parses and validates a material table.
+    pub fn parse(table: &toml::Table, base_dir: &std::path::Path) -> ParamResult<MaterialRecipe> {
+        let ty = match table.get("type") {
+            Some(toml::Value::String(s)) => s.as_str(),
+            Some(_) => return Err(ParamError::Invalid("`type` must be a string".into())),
+            None => {
+                return Err(ParamError::MissingKey {
+                    key: format!("type (one of: {})", MATERIAL_TYPES.join(", ")),
+                    context: "material".into(),
+                })
+            }
+        };
+        let p = Params::new(table, format!("material \"{ty}\""));
+        p.str("type")?;
+        match ty {
+            "lambert" | "diffuse" => {
+                let r = p.spectrum("reflectance")?.unwrap_or(Spectrum::splat(0.5));
+                p.finish(&keys(&["reflectance"], false))?;
+                Lambert::new(r)?;
+                Ok(MaterialRecipe::Lambert { reflectance: r })
+            }
+            "oren-nayar" => build_oren_nayar(&p),
+            "conductor" => build_conductor(&p),
+            "dielectric" => build_dielectric(&p),
+            "kelemen" => build_kelemen(&p),
+            "il" | "interfaced-lambertian" => build_il(&p, base_dir),
+            other => Err(ParamError::UnknownChoice {
+                what: "material type".into(),
+                given: other.into(),
+                valid: MATERIAL_TYPES.join(", "),
+            }),
         }
-    };
-    let p = Params::new(table, format!("material \"{ty}\""));
-    p.str("type")?;
-    match ty {
-        "lambert" | "diffuse" => {
-            let r = p.spectrum("reflectance")?.unwrap_or(Spectrum::splat(0.5));
-            p.finish(&keys(&["reflectance"], false))?;
-            Ok(Arc::new(Lambert::new(r)?))
-        }
-        "oren-nayar" => build_oren_nayar(&p),
-        "conductor" => build_conductor(&p),
-        "dielectric" => build_dielectric(&p),
-        "kelemen" => build_kelemen(&p),
-        "il" | "interfaced-lambertian" => build_il(&p, base_dir),
-        other => Err(ParamError::UnknownChoice {
-            what: "material type".into(),
-            given: other.into(),
-            valid: MATERIAL_TYPES.join(", "),
-        }),
     }
+
+    /// Builds the BSDF.
+    pub fn build(&self) -> ParamResult<Arc<dyn Bsdf>> {
+        Ok(match self {
+            MaterialRecipe::Lambert { reflectance } => Arc::new(Lambert::new(*reflectance)?),
+            MaterialRecipe::OrenNayar {
+                reflectance,
+                sigma,
+                model,
+                evaluation,
+            } => {
+                if *sigma == 0.0 {
+                    return Ok(Arc::new(Lambert::new(*reflectance)?));
+                }
+                match model {
+                    OrenNayarModel::Exact => {
+                        Arc::new(OrenNayarExact::new(*reflectance, *sigma, *evaluation)?)
+                    }
+                    OrenNayarModel::Qualitative => {
+                        Arc::new(OrenNayarQualitative::new(*reflectance, *sigma)?)
+                    }
+                    OrenNayarModel::L1 => Arc::new(OrenNayarQualitative::l1(*reflectance, *sigma)?),
+                }
+            }
+            MaterialRecipe::Conductor {
+                lobe,
+                fresnel,
+                tint,
+            } => Arc::new(RoughConductor::new(lobe.clone(), *fresnel, *tint)),
+            MaterialRecipe::Dielectric {
+                lobe,
+                eta,
+                widened,
+                reflect_tint,
+                transmit_tint,
+            } => Arc::new(RoughDielectric::new(
+                *eta,
+                lobe.clone(),
+                *widened,
+                *reflect_tint,
+                *transmit_tint,
+            )?),
+            MaterialRecipe::Kelemen(k) => k.clone(),
+            MaterialRecipe::Il {
+                kd,
+                ni,
+                lobe,
+                evaluation,
+                scattering,
+            } => {
+                let ev = match evaluation {
+                    IlEvaluation::Stochastic => BodyEvaluation::Stochastic,
+                    IlEvaluation::Quadrature { samples } => {
+                        BodyEvaluation::Quadrature { samples: *samples }
+                    }
+                    IlEvaluation::Table(t) => BodyEvaluation::Table(t.clone()),
+                    IlEvaluation::Approx => match lobe {
+                        Some(l) => BodyEvaluation::Approx(Arc::new(IlApprox::new(l, *ni)?)),
+                        None => BodyEvaluation::Stochastic,
+                    },
+                };
+                Arc::new(InterfacedLambertian::new(
+                    *kd,
+                    *ni,
+                    lobe.clone(),
+                    ev,
+                    *scattering,
+                )?)
+            }
+        })
+    }
+
+    /// Spectrum-valued keys a texture may drive.
+    pub fn texturable_spectrum_keys(&self) -> &'static [&'static str] {
+        match self {
+            MaterialRecipe::Lambert { .. } | MaterialRecipe::OrenNayar { .. } => &["reflectance"],
+            MaterialRecipe::Conductor { .. } => &["specular_reflectance"],
+            MaterialRecipe::Dielectric { .. } => {
+                &["specular_reflectance", "specular_transmittance"]
+            }
+            MaterialRecipe::Kelemen(_) | MaterialRecipe::Il { .. } => &["kd"],
+        }
+    }
+
+    /// Scalar keys (roughness) a texture may drive.
+    pub fn texturable_scalar_keys(&self) -> &'static [&'static str] {
+        let lobe = match self {
+            MaterialRecipe::OrenNayar { .. } => return &["sigma"],
+            MaterialRecipe::Conductor { lobe, .. } | MaterialRecipe::Dielectric { lobe, .. } => {
+                lobe
+            }
+            MaterialRecipe::Il {
+                lobe, evaluation, ..
+            } => {
+                if matches!(evaluation, IlEvaluation::Table(_)) {
+                    return &[];
+                }
+                lobe
+            }
+            _ => return &[],
+        };
+        match lobe.as_ref().map(|l| &l.ndf) {
+            Some(Ndf::Beckmann(_)) | Some(Ndf::Ggx(_)) => &["alpha", "alpha_u", "alpha_v"],
+            Some(Ndf::Gaussian(_)) => &["sigma"],
+            Some(Ndf::Phong(p)) if p.g1_form() == crate::microfacet::PhongG1::Rational => {
+                &["exponent"]
+            }
+            _ => &[],
+        }
+    }
+
+    /// Replaces a spectrum parameter (validated like the table's value).
+    pub fn set_spectrum(&mut self, key: &str, v: Spectrum) -> ParamResult<()> {
+        let valid = self.texturable_spectrum_keys();
+        let bad = || {
+            ParamError::Invalid(format!(
+                "`{key}` cannot be textured here; texturable: {}",
+                valid.join(", ")
+            ))
+        };
+        check_spectrum(key, v, 0.0, 1.0)?;
+        match (self, key) {
+            (MaterialRecipe::Lambert { reflectance }, "reflectance")
+            | (MaterialRecipe::OrenNayar { reflectance, .. }, "reflectance")
+            | (
+                MaterialRecipe::Conductor {
+                    tint: reflectance, ..
+                },
+                "specular_reflectance",
+            )
+            | (
+                MaterialRecipe::Dielectric {
+                    reflect_tint: reflectance,
+                    ..
+                },
+                "specular_reflectance",
+            )
+            | (
+                MaterialRecipe::Dielectric {
+                    transmit_tint: reflectance,
+                    ..
+                },
+                "specular_transmittance",
+            )
+            | (
+                MaterialRecipe::Il {
+                    kd: reflectance, ..
+                },
+                "kd",
+            ) => *reflectance = v,
+            (MaterialRecipe::Kelemen(k), "kd") => *k = Arc::new(k.with_kd(v)?),
+            _ => return Err(bad()),
+        }
+        Ok(())
+    }
+
+    /// Replaces a roughness parameter (validated like the table's value).
+    pub fn set_scalar(&mut self, key: &str, v: f64) -> ParamResult<()> {
+        let valid = self.texturable_scalar_keys();
+        if !valid.contains(&key) {
+            return Err(ParamError::Invalid(format!(
+                "`{key}` cannot be textured here; texturable: {}",
+                if valid.is_empty() {
+                    "none".to_string()
+                } else {
+                    valid.join(", ")
+                }
+            )));
+        }
+        match self {
+            MaterialRecipe::OrenNayar { sigma, .. } => {
+                *sigma = check_range(
+                    "sigma",
+                    v,
+                    0.0,
+                    0.5 * std::f64::consts::PI,
+                    Bounds::ClosedOpen,
+                )?;
+            }
+            MaterialRecipe::Conductor { lobe: Some(l), .. }
+            | MaterialRecipe::Dielectric { lobe: Some(l), .. }
+            | MaterialRecipe::Il { lobe: Some(l), .. } => {
+                let ndf = with_roughness(&l.ndf, key, v)?;
+                *l = SpecularLobe::new(ndf, l.masking, l.sampling())?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// The distribution with one roughness parameter replaced (small values are clamped to the
+/// smallest rough width, 1e-4).
+fn with_roughness(ndf: &Ndf, key: &str, v: f64) -> ParamResult<Ndf> {
+    use crate::microfacet::{Beckmann, Gaussian, Ggx, Phong};
+    check_range(key, v, 0.0, 10.0, Bounds::Closed)?;
+    let w = v.max(crate::microfacet::SMOOTH_ALPHA);
+    Ok(match (ndf, key) {
+        (Ndf::Beckmann(b), "alpha") => Ndf::Beckmann(Beckmann::new(w, w)?.with_g1(b.g1_form())),
+        (Ndf::Beckmann(b), "alpha_u") => {
+            Ndf::Beckmann(Beckmann::new(w, b.alpha_y())?.with_g1(b.g1_form()))
+        }
+        (Ndf::Beckmann(b), "alpha_v") => {
+            Ndf::Beckmann(Beckmann::new(b.alpha_x(), w)?.with_g1(b.g1_form()))
+        }
+        (Ndf::Ggx(_), "alpha") => Ndf::Ggx(Ggx::new(w, w)?),
+        (Ndf::Ggx(g), "alpha_u") => Ndf::Ggx(Ggx::new(w, g.alpha_y())?),
+        (Ndf::Ggx(g), "alpha_v") => Ndf::Ggx(Ggx::new(g.alpha_x(), w)?),
+        (Ndf::Gaussian(_), "sigma") => Ndf::Gaussian(Gaussian::new(w)?),
+        (Ndf::Phong(_), "exponent") => Ndf::Phong(Phong::new(v)?),
+        _ => {
+            return Err(ParamError::Invalid(format!(
+                "`{key}` is not a roughness parameter of {}",
+                crate::microfacet::Distribution::describe(ndf)
+            )))
+        }
+    })
 }
 
 fn choice(what: &str, given: &str, valid: &[&str]) -> ParamError {
@@ -110,33 +396,36 @@ pub fn parse_evaluation(p: &Params, default_samples: usize) -> ParamResult<Integ
     }
 }
 
-fn build_oren_nayar(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
+fn build_oren_nayar(p: &Params) -> ParamResult<MaterialRecipe> {
     let r = p.spectrum("reflectance")?.unwrap_or(Spectrum::splat(0.5));
     let sigma = p.required_f64("sigma")?;
-    let model = p.str("model")?.unwrap_or("exact");
-    let out: Arc<dyn Bsdf> = match model {
+    let (model, evaluation) = match p.str("model")?.unwrap_or("exact") {
         "exact" => {
             let ev = parse_evaluation(p, 256)?;
             p.finish(&keys(
                 &["reflectance", "sigma", "model", "evaluation", "samples"],
                 false,
             ))?;
-            if sigma == 0.0 {
-                return Ok(Arc::new(Lambert::new(r)?));
-            }
-            Arc::new(OrenNayarExact::new(r, sigma, ev)?)
+            (OrenNayarModel::Exact, ev)
         }
         "qualitative" => {
             p.finish(&keys(&["reflectance", "sigma", "model"], false))?;
-            Arc::new(OrenNayarQualitative::new(r, sigma)?)
+            (OrenNayarModel::Qualitative, IntegralEvaluation::Stochastic)
         }
         "l1" => {
             p.finish(&keys(&["reflectance", "sigma", "model"], false))?;
-            Arc::new(OrenNayarQualitative::l1(r, sigma)?)
+            (OrenNayarModel::L1, IntegralEvaluation::Stochastic)
         }
         other => return Err(choice("model", other, &["exact", "qualitative", "l1"])),
     };
-    Ok(out)
+    let recipe = MaterialRecipe::OrenNayar {
+        reflectance: r,
+        sigma,
+        model,
+        evaluation,
+    };
+    recipe.build()?;
+    Ok(recipe)
 }
 
 /// The conductor's Fresnel term from `material`, `eta`/`k` and `fresnel`.
@@ -181,7 +470,7 @@ fn parse_conductor_fresnel(p: &Params) -> ParamResult<Fresnel> {
     }
 }
 
-fn build_conductor(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
+fn build_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
     let ndf = parse_distribution(p, true)?;
     let masking = parse_masking(p, ndf.as_ref())?;
     let sampling = match p.str("sampling")? {
@@ -203,10 +492,14 @@ fn build_conductor(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
     };
-    Ok(Arc::new(RoughConductor::new(lobe, fresnel, tint)))
+    Ok(MaterialRecipe::Conductor {
+        lobe,
+        fresnel,
+        tint,
+    })
 }
 
-fn build_dielectric(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
+fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
     let preset = p.str("preset")?;
     let (ndf, ior) = match preset {
         Some(name) => {
@@ -288,16 +581,18 @@ fn build_dielectric(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
     };
-    Ok(Arc::new(RoughDielectric::new(
-        ior / ext,
+    let recipe = MaterialRecipe::Dielectric {
         lobe,
+        eta: ior / ext,
         widened,
-        rt,
-        tt,
-    )?))
+        reflect_tint: rt,
+        transmit_tint: tt,
+    };
+    recipe.build()?;
+    Ok(recipe)
 }
 
-fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>> {
+fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<MaterialRecipe> {
     let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
     let ni = p.f64_or("ni", 1.5)?;
     let scattering = Scattering::parse(p.str("scattering")?.unwrap_or("single"))?;
@@ -318,8 +613,8 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>
     } else {
         "stochastic"
     }) {
-        "stochastic" => BodyEvaluation::Stochastic,
-        "quadrature" => BodyEvaluation::Quadrature {
+        "stochastic" => IlEvaluation::Stochastic,
+        "quadrature" => IlEvaluation::Quadrature {
             samples: samples.unwrap_or(1024),
         },
         "table" => {
@@ -329,24 +624,17 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>
             })?;
             let full = base_dir.join(path);
             let t = BodyTable::load(&full).map_err(|e| ParamError::Invalid(e.to_string()))?;
-            BodyEvaluation::Table(Arc::new(t))
+            IlEvaluation::Table(Arc::new(t))
         }
-        "approx" => match &ndf {
-            Some(n) => {
-                let lobe = SpecularLobe::new(n.clone(), masking, sampling)?;
-                BodyEvaluation::Approx(Arc::new(IlApprox::new(&lobe, ni)?))
-            }
-            // Flat IL is closed-form already.
-            None => BodyEvaluation::Stochastic,
-        },
+        "approx" => IlEvaluation::Approx,
         other => return Err(choice("evaluation", other, BodyEvaluation::NAMES)),
     };
-    if samples.is_some() && !matches!(evaluation, BodyEvaluation::Quadrature { .. }) {
+    if samples.is_some() && !matches!(evaluation, IlEvaluation::Quadrature { .. }) {
         return Err(ParamError::Invalid(
             "`samples` applies to evaluation = \"quadrature\"".into(),
         ));
     }
-    if table_path.is_some() && !matches!(evaluation, BodyEvaluation::Table(_)) {
+    if table_path.is_some() && !matches!(evaluation, IlEvaluation::Table(_)) {
         return Err(ParamError::Invalid(
             "`table` applies to evaluation = \"table\"".into(),
         ));
@@ -359,12 +647,18 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Arc<dyn Bsdf>
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
     };
-    Ok(Arc::new(InterfacedLambertian::new(
-        kd, ni, lobe, evaluation, scattering,
-    )?))
+    let recipe = MaterialRecipe::Il {
+        kd,
+        ni,
+        lobe,
+        evaluation,
+        scattering,
+    };
+    recipe.build()?;
+    Ok(recipe)
 }
 
-fn build_kelemen(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
+fn build_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let name = p.str("distribution")?.unwrap_or("ward");
     let rough = match name {
         "phong" => p.required_f64("exponent")?,
@@ -385,12 +679,12 @@ fn build_kelemen(p: &Params) -> ParamResult<Arc<dyn Bsdf>> {
         ],
         false,
     ))?;
-    Ok(Arc::new(Kelemen::new(
+    Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::new(
         density,
         Fresnel::Dielectric { eta: ior },
         kd,
         samples,
-    )?))
+    )?)))
 }
 
 #[cfg(test)]
@@ -419,6 +713,38 @@ mod tests {
             let b = build(s).unwrap_or_else(|e| panic!("{s}: {e}"));
             assert!(!b.describe().is_empty());
         }
+    }
+
+    #[test]
+    fn recipes_take_texture_overrides() {
+        let t = parse_inline_table(r#"{type = "il", kd = 0.5, distribution = "ggx", alpha = 0.3}"#)
+            .unwrap();
+        let mut r = MaterialRecipe::parse(&t, std::path::Path::new(".")).unwrap();
+        r.set_spectrum("kd", Spectrum::rgb(0.9, 0.1, 0.1)).unwrap();
+        r.set_scalar("alpha", 0.05).unwrap();
+        let d = r.build().unwrap().describe();
+        assert!(
+            d.contains("kd=[0.9, 0.1, 0.1]") && d.contains("ggx(alpha=0.05)"),
+            "{d}"
+        );
+        let e = r.set_scalar("sigma", 0.2).unwrap_err().to_string();
+        assert!(e.contains("texturable: alpha, alpha_u, alpha_v"), "{e}");
+        let e = r
+            .set_spectrum("kd", Spectrum::splat(1.5))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("kd"), "{e}");
+        let t =
+            parse_inline_table(r#"{type = "kelemen", alpha = 0.3, table_samples = 256}"#).unwrap();
+        let mut k = MaterialRecipe::parse(&t, std::path::Path::new(".")).unwrap();
+        k.set_spectrum("kd", Spectrum::splat(0.25)).unwrap();
+        assert!(k.texturable_scalar_keys().is_empty());
+        let t = parse_inline_table(r#"{type = "conductor", alpha = 0}"#).unwrap();
+        let mut c = MaterialRecipe::parse(&t, std::path::Path::new(".")).unwrap();
+        assert!(
+            c.set_scalar("alpha", 0.2).is_err(),
+            "a smooth conductor has no roughness to texture"
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@ pub mod material;
 pub mod microfacet;
 pub mod params;
 
-pub use material::{build_material, build_material_in, MATERIAL_TYPES};
+pub use material::{build_material, build_material_in, MaterialRecipe, MATERIAL_TYPES};
 pub use params::Params;
 
 use crate::error::ParamError;
