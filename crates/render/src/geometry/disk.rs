@@ -212,6 +212,14 @@ mod tests {
         assert!(d
             .intersect(&Ray::infinite(Vec3::new(-2.0, 0.0, 0.0), Vec3::X))
             .is_none());
+        // Grazing: nearly parallel to the plane, still found inside the disk, at the rim.
+        let g = Ray::infinite(Vec3::new(-5.0, 0.0, 1e-7), Vec3::new(1.0, 0.0, -2e-8));
+        let hg = d.intersect(&g).unwrap();
+        assert!((hg.p.x - 0.0).abs() < 1e-8 && hg.p.z == 0.0);
+        let rim = Ray::infinite(Vec3::new(1.0 - 1e-12, 0.0, 1.0), -Vec3::Z);
+        assert!(d.intersect(&rim).is_some());
+        let out = Ray::infinite(Vec3::new(1.0 + 1e-12, 0.0, 1.0), -Vec3::Z);
+        assert!(d.intersect(&out).is_none());
         let h = d
             .intersect(&Ray::infinite(Vec3::new(0.0, 0.5, 3.0), -Vec3::Z))
             .unwrap();

@@ -247,6 +247,12 @@ mod tests {
     }
 
     #[test]
+    fn is_shareable_across_threads() {
+        fn assert_send_sync<T: Send + Sync>() {}
+        assert_send_sync::<SceneGeometry>();
+    }
+
+    #[test]
     fn empty_scene() {
         let s = SceneGeometry::new(vec![]).unwrap();
         assert!(s.intersect(&Ray::infinite(Vec3::ZERO, Vec3::Z)).is_none());

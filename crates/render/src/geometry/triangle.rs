@@ -71,9 +71,10 @@ impl TriangleRay {
     #[inline]
     pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f64) -> Option<PrimHit> {
         let (kx, ky, kz) = (self.kx, self.ky, self.kz);
-        let a = p0 - self.origin;
-        let b = p1 - self.origin;
-        let c = p2 - self.origin;
+        // Arrays: indexing by the permutation is a plain load.
+        let a = (p0 - self.origin).to_array();
+        let b = (p1 - self.origin).to_array();
+        let c = (p2 - self.origin).to_array();
         let ax = a[kx] - self.sx * a[kz];
         let ay = a[ky] - self.sy * a[kz];
         let bx = b[kx] - self.sx * b[kz];
@@ -157,6 +158,19 @@ mod tests {
         assert!(hit(Vec3::new(0.2, 0.2, 1.0), Vec3::Z, f64::INFINITY).is_none());
         assert!(hit(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 0.99).is_none());
         assert!(hit(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 1.0).is_some());
+        // Grazing at 1e-9 rad: still hit, at the right place.
+        let g = hit(
+            Vec3::new(-1.0, 0.25, 1e-9),
+            Vec3::new(1.0, 0.0, -1e-9),
+            f64::INFINITY,
+        )
+        .unwrap();
+        assert!((g.local - Vec2::new(0.0, 0.25)).abs().max_element() < 1e-8);
+        // Just outside each edge.
+        assert!(hit(Vec3::new(0.5, -1e-12, 1.0), -Vec3::Z, f64::INFINITY).is_none());
+        assert!(hit(Vec3::new(-1e-12, 0.5, 1.0), -Vec3::Z, f64::INFINITY).is_none());
+        assert!(hit(Vec3::new(0.5 + 1e-12, 0.5, 1.0), -Vec3::Z, f64::INFINITY).is_none());
+        assert!(hit(Vec3::new(0.5 - 1e-12, 0.5, 1.0), -Vec3::Z, f64::INFINITY).is_some());
         // In the plane of the triangle.
         assert!(hit(Vec3::new(-1.0, 0.2, 0.0), Vec3::X, f64::INFINITY).is_none());
         // Degenerate triangle.
