@@ -1,0 +1,301 @@
+//! PLY (ASCII, binary little- and big-endian) through `ply-rs`.
+//!
+//! Read: the `vertex` element's `x y z`, optional `nx ny nz`, optional texture
+//! coordinates named `u v`, `s t`, `texture_u texture_v` or `texture_s texture_t` (any
+//! scalar type); the `face` element's `vertex_indices` (or `vertex_index`) list, polygons
+//! fan-triangulated (faces of fewer than three vertices are skipped). Other elements and
+//! properties are ignored. For ASCII files, index and finiteness errors report the line
+//! of the offending element; `ply-rs` parse errors carry their own line in the message.
+
+use crate::geometry::error::{GeometryError, GeometryResult};
+use crate::geometry::mesh_data::MeshData;
+use crate::geometry::{Vec2, Vec3};
+use ply_rs::parser::Parser;
+use ply_rs::ply::{Encoding, Header, Property, PropertyAccess};
+use std::path::Path;
+
+/// Reads a PLY file.
+pub fn read_ply(path: &Path) -> GeometryResult<MeshData> {
+    let bytes = std::fs::read(path).map_err(|source| GeometryError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_ply(&bytes).map_err(|(e, line)| e.in_file(path, line))
+}
+
+const X: usize = 0;
+const NX: usize = 3;
+const U: usize = 6;
+const V: usize = 7;
+
+/// One element of any kind; only the properties we read are kept.
+#[derive(Default)]
+struct Record {
+    values: [f64; 8],
+    indices: Vec<i64>,
+    non_integer_indices: bool,
+}
+
+fn scalar(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::Char(x) => x as f64,
+        Property::UChar(x) => x as f64,
+        Property::Short(x) => x as f64,
+        Property::UShort(x) => x as f64,
+        Property::Int(x) => x as f64,
+        Property::UInt(x) => x as f64,
+        Property::Float(x) => x as f64,
+        Property::Double(x) => x,
+        _ => return None,
+    })
+}
+
+/// Integer list as i64; `None` if a float list holds a non-integer.
+fn index_list(p: Property) -> Option<Vec<i64>> {
+    fn ints<T: Into<i64> + Copy>(v: &[T]) -> Option<Vec<i64>> {
+        Some(v.iter().map(|&x| x.into()).collect())
+    }
+    fn floats(v: impl Iterator<Item = f64>) -> Option<Vec<i64>> {
+        v.map(|x| (x.fract() == 0.0 && x.abs() < 9.0e15).then_some(x as i64))
+            .collect()
+    }
+    match p {
+        Property::ListChar(v) => ints(&v),
+        Property::ListUChar(v) => ints(&v),
+        Property::ListShort(v) => ints(&v),
+        Property::ListUShort(v) => ints(&v),
+        Property::ListInt(v) => ints(&v),
+        Property::ListUInt(v) => ints(&v),
+        Property::ListFloat(v) => floats(v.into_iter().map(|x| x as f64)),
+        Property::ListDouble(v) => floats(v.into_iter()),
+        _ => None,
+    }
+}
+
+fn slot(name: &str) -> Option<usize> {
+    Some(match name {
+        "x" => X,
+        "y" => X + 1,
+        "z" => X + 2,
+        "nx" => NX,
+        "ny" => NX + 1,
+        "nz" => NX + 2,
+        "u" | "s" | "texture_u" | "texture_s" => U,
+        "v" | "t" | "texture_v" | "texture_t" => V,
+        _ => return None,
+    })
+}
+
+impl PropertyAccess for Record {
+    fn new() -> Self {
+        Record::default()
+    }
+
+    fn set_property(&mut self, name: String, property: Property) {
+        if name == "vertex_indices" || name == "vertex_index" {
+            match index_list(property) {
+                Some(list) => self.indices = list,
+                None => self.non_integer_indices = true,
+            }
+        } else if let (Some(k), Some(x)) = (slot(&name), scalar(&property)) {
+            self.values[k] = x;
+        }
+    }
+}
+
+/// Line numbers of an ASCII file's elements.
+struct AsciiLines {
+    /// Line of the first element of each element kind, in header order.
+    first: Vec<(String, usize)>,
+}
+
+impl AsciiLines {
+    fn new(bytes: &[u8], header: &Header) -> Option<AsciiLines> {
+        if header.encoding != Encoding::Ascii {
+            return None;
+        }
+        let end = find(bytes, b"end_header")?;
+        let header_lines = bytes[..end].iter().filter(|&&b| b == b'\n').count() + 1;
+        let mut line = header_lines + 1;
+        let mut first = Vec::new();
+        for (name, e) in header.elements.iter() {
+            first.push((name.clone(), line));
+            line += e.count;
+        }
+        Some(AsciiLines { first })
+    }
+
+    fn line(&self, element: &str, k: usize) -> Option<usize> {
+        self.first
+            .iter()
+            .find(|(n, _)| n == element)
+            .map(|(_, l)| l + k)
+    }
+}
+
+fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
+    haystack.windows(needle.len()).position(|w| w == needle)
+}
+
+fn parse_ply(bytes: &[u8]) -> Result<MeshData, (GeometryError, Option<usize>)> {
+    let malformed = |message: String| {
+        (
+            GeometryError::Malformed {
+                format: "PLY",
+                message,
+            },
+            None,
+        )
+    };
+    let parser = Parser::<Record>::new();
+    let ply = parser
+        .read_ply(&mut &bytes[..])
+        .map_err(|e| malformed(e.to_string()))?;
+    let lines = AsciiLines::new(bytes, &ply.header);
+    let line_of = |element: &str, k: usize| lines.as_ref().and_then(|l| l.line(element, k));
+
+    let Some(vertex_def) = ply.header.elements.get("vertex") else {
+        return Err(malformed("no `vertex` element".into()));
+    };
+    let has = |names: &[&str]| names.iter().any(|n| vertex_def.properties.contains_key(*n));
+    if !(has(&["x"]) && has(&["y"]) && has(&["z"])) {
+        return Err(malformed(
+            "the `vertex` element lacks one of the properties x, y, z".into(),
+        ));
+    }
+    let has_normals = has(&["nx"]) && has(&["ny"]) && has(&["nz"]);
+    let has_uvs =
+        has(&["u", "s", "texture_u", "texture_s"]) && has(&["v", "t", "texture_v", "texture_t"]);
+    let empty = Vec::new();
+    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+
+    let mut data = MeshData {
+        positions: Vec::with_capacity(vertices.len()),
+        normals: has_normals.then(|| Vec::with_capacity(vertices.len())),
+        uvs: has_uvs.then(|| Vec::with_capacity(vertices.len())),
+        indices: Vec::new(),
+    };
+    for (k, r) in vertices.iter().enumerate() {
+        let v = &r.values;
+        let p = Vec3::new(v[X], v[X + 1], v[X + 2]);
+        let n = Vec3::new(v[NX], v[NX + 1], v[NX + 2]);
+        let uv = Vec2::new(v[U], v[V]);
+        let bad = if !p.is_finite() {
+            Some(("position", format!("{p}")))
+        } else if has_normals && !n.is_finite() {
+            Some(("normal", format!("{n}")))
+        } else if has_uvs && !uv.is_finite() {
+            Some(("uv", format!("{uv}")))
+        } else {
+            None
+        };
+        if let Some((attribute, value)) = bad {
+            return Err((
+                GeometryError::NonFiniteVertex {
+                    attribute,
+                    index: k,
+                    value,
+                },
+                line_of("vertex", k),
+            ));
+        }
+        data.positions.push(p);
+        if let Some(ns) = &mut data.normals {
+            ns.push(n);
+        }
+        if let Some(uvs) = &mut data.uvs {
+            uvs.push(uv);
+        }
+    }
+
+    let Some(face_def) = ply.header.elements.get("face") else {
+        return Err((GeometryError::NoTriangles, None));
+    };
+    if !(face_def.properties.contains_key("vertex_indices")
+        || face_def.properties.contains_key("vertex_index"))
+    {
+        return Err(malformed(
+            "the `face` element has no `vertex_indices` (or `vertex_index`) list".into(),
+        ));
+    }
+    let faces = ply.payload.get("face").unwrap_or(&empty);
+    let n = data.positions.len();
+    for (f, r) in faces.iter().enumerate() {
+        if r.non_integer_indices {
+            return Err((
+                GeometryError::Malformed {
+                    format: "PLY",
+                    message: format!("face {f}: vertex indices must be integers"),
+                },
+                line_of("face", f),
+            ));
+        }
+        if let Some(&index) = r.indices.iter().find(|&&i| i < 0 || i as u64 >= n as u64) {
+            return Err((
+                GeometryError::IndexOutOfRange {
+                    index,
+                    face: f,
+                    vertex_count: n,
+                },
+                line_of("face", f),
+            ));
+        }
+        for k in 1..r.indices.len().saturating_sub(1) {
+            data.indices
+                .extend([r.indices[0], r.indices[k], r.indices[k + 1]].map(|i| i as u32));
+        }
+    }
+    if data.indices.is_empty() {
+        return Err((GeometryError::NoTriangles, None));
+    }
+    Ok(data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const QUAD: &str = "ply\nformat ascii 1.0\ncomment a unit quad\n\
+        element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+        property float s\nproperty float t\n\
+        element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+        0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n";
+
+    #[test]
+    fn ascii_quad_with_st_is_fanned() {
+        let d = parse_ply(QUAD.as_bytes()).unwrap();
+        assert_eq!(d.indices, vec![0, 1, 2, 0, 2, 3]);
+        assert!(d.normals.is_none());
+        assert_eq!(d.uvs.as_ref().unwrap()[2], Vec2::ONE);
+        assert_eq!(d.positions[1], Vec3::X);
+    }
+
+    #[test]
+    fn ascii_errors_have_lines() {
+        let bad_index = QUAD.replace("4 0 1 2 3", "4 0 1 2 9");
+        let (e, line) = parse_ply(bad_index.as_bytes()).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                GeometryError::IndexOutOfRange {
+                    index: 9,
+                    face: 0,
+                    vertex_count: 4
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(line, Some(17));
+        // ply-rs's ASCII grammar has no NaN/inf literals: they are parse errors, with the
+        // parser's own line number (non-finite binary values are tested in
+        // tests/geometry_mesh_io.rs).
+        for bad in ["1 nan 0 1 1", "1 one 0 1 1"] {
+            let garbage = QUAD.replace("1 1 0 1 1", bad);
+            let (e, _) = parse_ply(garbage.as_bytes()).unwrap_err();
+            assert!(matches!(e, GeometryError::Malformed { .. }), "{e}");
+            assert!(e.to_string().contains("Line 15"), "{e}");
+        }
+        let (e, _) = parse_ply(b"not a ply file\n").unwrap_err();
+        assert!(matches!(e, GeometryError::Malformed { .. }));
+    }
+}

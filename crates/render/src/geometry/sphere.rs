@@ -1,0 +1,388 @@
+//! The analytic sphere, with Mitsuba 3's parameterization (`src/shapes/sphere.cpp`).
+//!
+//! | parameter      | meaning                                                           |
+//! |----------------|-------------------------------------------------------------------|
+//! | `center`       | centre (default origin)                                           |
+//! | `radius`       | radius > 0 (default 1)                                            |
+//! | `to_world`     | similarity transform (rotation, uniform scale, translation); the  |
+//! |                | effective object-to-world map is `to_world · translate(center) ·  |
+//! |                | scale(radius)`, as in Mitsuba                                     |
+//! | `flip_normals` | normals point inward                                              |
+//!
+//! # Conventions
+//! With `l` the hit point on the unit sphere of object space (`θ` polar angle from local
+//! +z, `φ` azimuth from local +x towards +y, in [0, 2π)):
+//! - `uv = (φ / 2π, θ / π)`: `v = 0` at the local north pole (+z), `u = 0` on the local
+//!   +x half-plane;
+//! - `dpdu = to_world · 2π (−l.y, l.x, 0)`, `dpdv = to_world · π (l.z cos φ, l.z sin φ,
+//!   −sin θ)` — the true partial derivatives of the point with respect to `uv` (at the
+//!   poles Mitsuba's choice `dpdv ∝ (1, 0, 0)` is kept);
+//! - `ng = ns` = outward unit normal, inverted by `flip_normals`. As in Mitsuba, a
+//!   mirroring `to_world` (negative determinant) also inverts the normals.
+//!
+//! Non-uniform scale and shear are rejected (Mitsuba only warns; the result would not be a
+//! sphere).
+
+use super::bounds::Bounds3;
+use super::error::{GeometryError, GeometryResult};
+use super::interaction::{PrimHit, SurfaceHit};
+use super::ray::Ray;
+use super::transform::Transform;
+use super::{Vec2, Vec3};
+use facette_bsdf::math::warp::square_to_uniform_sphere;
+use std::f64::consts::{PI, TAU};
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sphere {
+    /// Object (unit sphere) to world.
+    to_world: Transform,
+    center: Vec3,
+    radius: f64,
+    flip_normals: bool,
+}
+
+impl Sphere {
+    /// A sphere of `radius` at `center`, outward normals.
+    pub fn new(center: Vec3, radius: f64) -> GeometryResult<Sphere> {
+        Self::with_transform(center, radius, &Transform::IDENTITY, false)
+    }
+
+    /// The full Mitsuba parameter set: the unit sphere placed by `to_world ·
+    /// translate(center) · scale(radius)`.
+    pub fn with_transform(
+        center: Vec3,
+        radius: f64,
+        to_world: &Transform,
+        flip_normals: bool,
+    ) -> GeometryResult<Sphere> {
+        if !center.is_finite() {
+            return Err(param("center", format!("{center}"), "finite coordinates"));
+        }
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(param("radius", format!("{radius}"), "a finite number > 0"));
+        }
+        let placed =
+            *to_world * Transform::translate(center)? * Transform::scale(Vec3::splat(radius))?;
+        let Some(world_radius) = placed.similarity_scale() else {
+            return Err(GeometryError::UnsupportedTransform {
+                shape: "sphere",
+                reason: "it must be a rotation, uniform scale and translation (no shear, \
+                         non-uniform scale or perspective)",
+            });
+        };
+        let mirrored = placed.linear_determinant() < 0.0;
+        Ok(Sphere {
+            center: placed.point(Vec3::ZERO),
+            radius: world_radius,
+            to_world: placed,
+            flip_normals: flip_normals != mirrored,
+        })
+    }
+
+    #[inline]
+    pub fn center(&self) -> Vec3 {
+        self.center
+    }
+
+    #[inline]
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Whether normals point inward.
+    #[inline]
+    pub fn flip_normals(&self) -> bool {
+        self.flip_normals
+    }
+
+    /// The object-to-world transform of the unit sphere (centre and radius included).
+    #[inline]
+    pub fn to_world(&self) -> &Transform {
+        &self.to_world
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        Bounds3::new(
+            self.center - Vec3::splat(self.radius),
+            self.center + Vec3::splat(self.radius),
+        )
+    }
+
+    #[inline]
+    pub fn area(&self) -> f64 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// The nearest hit in `(0, ray.t_max]`. From inside the sphere this is the far
+    /// root. The quadratic is solved as in pbrt-v4 (`Sphere::BasicIntersect`): the
+    /// discriminant from the distance between the centre and the ray's closest point
+    /// (no cancellation for distant origins) and the stable root pair `q`, `c/q`.
+    pub fn intersect_prim(&self, ray: &Ray) -> Option<PrimHit> {
+        let o = ray.origin - self.center;
+        let d = ray.dir;
+        let a = d.length_squared();
+        if !(a > 0.0) {
+            return None;
+        }
+        let half_b = o.dot(d);
+        let c = o.length_squared() - self.radius * self.radius;
+        let closest = (o - (half_b / a) * d).length();
+        let disc = a * (self.radius + closest) * (self.radius - closest);
+        if !(disc >= 0.0) {
+            return None;
+        }
+        let root = disc.sqrt();
+        let q = if half_b > 0.0 {
+            -(half_b + root)
+        } else {
+            -(half_b - root)
+        };
+        if q == 0.0 {
+            // Origin on the sphere, ray tangent: both roots are 0.
+            return None;
+        }
+        let (mut t0, mut t1) = (q / a, c / q);
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        if !(t0 <= ray.t_max && t1 > 0.0) {
+            return None;
+        }
+        let t = if t0 > 0.0 { t0 } else { t1 };
+        (t <= ray.t_max).then_some(PrimHit {
+            t,
+            local: Vec2::ZERO,
+        })
+    }
+
+    /// The surface details of a hit found by [`intersect_prim`](Self::intersect_prim).
+    pub fn surface_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {
+        let outward = (ray.at(hit.t) - self.center).normalize_or_zero();
+        let outward = if outward == Vec3::ZERO {
+            -ray.dir
+        } else {
+            outward
+        };
+        // Re-project onto the surface (Mitsuba does the same) to bound the error of `p`.
+        let p = self.center + self.radius * outward;
+        let (uv, dpdu, dpdv) = self.parameterization(outward);
+        let n = if self.flip_normals { -outward } else { outward };
+        SurfaceHit {
+            t: hit.t,
+            p,
+            ng: n,
+            ns: n,
+            uv,
+            dpdu,
+            dpdv,
+            shape,
+            prim: 0,
+        }
+    }
+
+    /// Hit with shape index 0 (for using a sphere on its own).
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
+        self.intersect_prim(ray)
+            .map(|h| self.surface_hit(ray, h, 0))
+    }
+
+    /// uv and its derivatives at the point in world direction `outward` from the centre.
+    fn parameterization(&self, outward: Vec3) -> (Vec2, Vec3, Vec3) {
+        let l = self.to_world.inverse_vector(outward).normalize_or_zero();
+        let theta = l.z.clamp(-1.0, 1.0).acos();
+        let mut phi = l.y.atan2(l.x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        let uv = Vec2::new(phi / TAU, theta / PI);
+        let dpdu_local = TAU * Vec3::new(-l.y, l.x, 0.0);
+        let rd = (l.x * l.x + l.y * l.y).sqrt();
+        let dpdv_local = if rd > 0.0 {
+            PI * Vec3::new(l.z * l.x / rd, l.z * l.y / rd, -rd)
+        } else {
+            PI * Vec3::X
+        };
+        (
+            uv,
+            self.to_world.vector(dpdu_local),
+            self.to_world.vector(dpdv_local),
+        )
+    }
+
+    /// Uniform sample of the surface: `(point, normal, pdf per unit area = 1/area)`.
+    pub fn sample(&self, u: Vec2) -> (Vec3, Vec3, f64) {
+        let local = square_to_uniform_sphere(u);
+        let outward = self.to_world.vector(local).normalize_or_zero();
+        let p = self.center + self.radius * outward;
+        let n = if self.flip_normals { -outward } else { outward };
+        (p, n, 1.0 / self.area())
+    }
+}
+
+fn param(name: &'static str, value: String, expected: &'static str) -> GeometryError {
+    GeometryError::InvalidShapeParameter {
+        shape: "sphere",
+        name,
+        value,
+        expected,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
+        (a - b).abs().max_element() <= tol
+    }
+
+    #[test]
+    fn hits_from_outside_and_inside() {
+        let s = Sphere::new(Vec3::new(0.0, 0.0, 5.0), 2.0).unwrap();
+        let h = s.intersect(&Ray::infinite(Vec3::ZERO, Vec3::Z)).unwrap();
+        assert!((h.t - 3.0).abs() < 1e-14);
+        assert!(close(h.p, Vec3::new(0.0, 0.0, 3.0), 1e-14));
+        assert!(close(h.ng, -Vec3::Z, 1e-15));
+        // Inside: far root, normal still outward.
+        let h = s
+            .intersect(&Ray::infinite(Vec3::new(0.0, 0.0, 5.0), Vec3::X))
+            .unwrap();
+        assert!((h.t - 2.0).abs() < 1e-14);
+        assert!(close(h.ng, Vec3::X, 1e-15));
+        // Miss, behind, t_max.
+        assert!(s
+            .intersect(&Ray::infinite(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0)))
+            .is_none());
+        assert!(s.intersect(&Ray::infinite(Vec3::ZERO, -Vec3::Z)).is_none());
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z, 2.999)).is_none());
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z, 3.001)).is_some());
+        assert!(s
+            .intersect(&Ray::new(Vec3::ZERO, Vec3::ZERO, 10.0))
+            .is_none());
+    }
+
+    #[test]
+    fn grazing_rays() {
+        let s = Sphere::new(Vec3::ZERO, 1.0).unwrap();
+        // Tangent at x = 1 (touches), slightly outside (misses), slightly inside (hits twice).
+        let inside = Ray::infinite(Vec3::new(1.0 - 1e-9, -10.0, 0.0), Vec3::Y);
+        let h = s.intersect(&inside).unwrap();
+        assert!((h.p.length() - 1.0).abs() < 1e-14);
+        assert!(h.t < 10.0);
+        let outside = Ray::infinite(Vec3::new(1.0 + 1e-9, -10.0, 0.0), Vec3::Y);
+        assert!(s.intersect(&outside).is_none());
+        let tangent = Ray::infinite(Vec3::new(1.0, -10.0, 0.0), Vec3::Y);
+        if let Some(h) = s.intersect(&tangent) {
+            assert!((h.t - 10.0).abs() < 1e-6 && h.p.is_finite());
+        }
+    }
+
+    #[test]
+    fn distant_origin_stays_accurate() {
+        let s = Sphere::new(Vec3::ZERO, 1.0).unwrap();
+        let h = s
+            .intersect(&Ray::infinite(Vec3::new(0.5, 0.0, -1e7), Vec3::Z))
+            .unwrap();
+        assert!((h.p.length() - 1.0).abs() < 1e-15);
+        assert!((h.p.z + 0.75f64.sqrt()).abs() < 1e-8);
+    }
+
+    #[test]
+    fn uv_and_derivatives_follow_mitsuba() {
+        let s = Sphere::new(Vec3::new(1.0, 2.0, 3.0), 2.0).unwrap();
+        // Point at θ = 60°, φ = 120°.
+        let (theta, phi) = (PI / 3.0, 2.0 * PI / 3.0);
+        let dir = Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        let target = s.center() + 2.0 * dir;
+        let h = s
+            .intersect(&Ray::infinite(target + 3.0 * dir, -dir))
+            .unwrap();
+        assert!(close(h.p, target, 1e-13));
+        assert!((h.uv.x - 1.0 / 3.0).abs() < 1e-14);
+        assert!((h.uv.y - 1.0 / 3.0).abs() < 1e-14);
+        // Finite differences of p(u, v) = c + r (sin πv cos 2πu, sin πv sin 2πu, cos πv).
+        let p = |u: f64, v: f64| {
+            s.center()
+                + 2.0
+                    * Vec3::new(
+                        (PI * v).sin() * (TAU * u).cos(),
+                        (PI * v).sin() * (TAU * u).sin(),
+                        (PI * v).cos(),
+                    )
+        };
+        let e = 1e-6;
+        let fd_u = (p(h.uv.x + e, h.uv.y) - p(h.uv.x - e, h.uv.y)) / (2.0 * e);
+        let fd_v = (p(h.uv.x, h.uv.y + e) - p(h.uv.x, h.uv.y - e)) / (2.0 * e);
+        assert!(close(h.dpdu, fd_u, 1e-6), "{} vs {fd_u}", h.dpdu);
+        assert!(close(h.dpdv, fd_v, 1e-6), "{} vs {fd_v}", h.dpdv);
+        assert!(h.dpdu.dot(h.ng).abs() < 1e-12 && h.dpdv.dot(h.ng).abs() < 1e-12);
+        // v = 0 at the north pole, u = 0 on +x.
+        let top = s
+            .intersect(&Ray::infinite(s.center() + Vec3::Z * 5.0, -Vec3::Z))
+            .unwrap();
+        assert!(top.uv.y.abs() < 1e-12);
+        let east = s
+            .intersect(&Ray::infinite(s.center() + Vec3::X * 5.0, -Vec3::X))
+            .unwrap();
+        assert!(east.uv.x.abs() < 1e-12 && (east.uv.y - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn rotation_frame_moves_the_parameterization() {
+        // Local +z mapped to world +x: the pole (v = 0) is now on +x.
+        let rot = Transform::rotate(Vec3::Y, 90.0).unwrap();
+        let s = Sphere::with_transform(Vec3::ZERO, 1.0, &rot, false).unwrap();
+        let h = s
+            .intersect(&Ray::infinite(Vec3::X * 3.0, -Vec3::X))
+            .unwrap();
+        assert!(h.uv.y.abs() < 1e-12);
+        assert!(close(h.ng, Vec3::X, 1e-15));
+    }
+
+    #[test]
+    fn flip_and_mirror_invert_normals() {
+        let s = Sphere::with_transform(Vec3::ZERO, 1.0, &Transform::IDENTITY, true).unwrap();
+        let h = s
+            .intersect(&Ray::infinite(Vec3::Z * 3.0, -Vec3::Z))
+            .unwrap();
+        assert!(close(h.ng, -Vec3::Z, 1e-15) && close(h.ns, -Vec3::Z, 1e-15));
+        let mirror = Transform::scale(Vec3::splat(-1.0)).unwrap();
+        let m = Sphere::with_transform(Vec3::ZERO, 1.0, &mirror, false).unwrap();
+        assert!(m.flip_normals());
+        assert!((m.radius() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rejects_bad_parameters() {
+        assert!(Sphere::new(Vec3::ZERO, 0.0).is_err());
+        assert!(Sphere::new(Vec3::ZERO, f64::NAN).is_err());
+        assert!(Sphere::new(Vec3::new(f64::INFINITY, 0.0, 0.0), 1.0).is_err());
+        let squash = Transform::scale(Vec3::new(1.0, 2.0, 1.0)).unwrap();
+        let e = Sphere::with_transform(Vec3::ZERO, 1.0, &squash, false).unwrap_err();
+        assert!(e.to_string().contains("sphere"), "{e}");
+        let msg = Sphere::new(Vec3::ZERO, -1.0).unwrap_err().to_string();
+        assert!(msg.contains("radius") && msg.contains("-1"), "{msg}");
+    }
+
+    #[test]
+    fn samples_lie_on_the_surface_with_pdf_one_over_area() {
+        let s = Sphere::new(Vec3::new(-1.0, 0.5, 2.0), 0.7).unwrap();
+        let mut rng = facette_bsdf::math::rng::Pcg32::new(7, 0);
+        use facette_bsdf::math::rng::RandomSource;
+        let mut mean = Vec3::ZERO;
+        let n = 20_000;
+        for _ in 0..n {
+            let (p, nrm, pdf) = s.sample(rng.next_2d());
+            assert!(((p - s.center()).length() - 0.7).abs() < 1e-14);
+            assert!(close(nrm, (p - s.center()) / 0.7, 1e-13));
+            assert!((pdf * s.area() - 1.0).abs() < 1e-14);
+            mean += p;
+        }
+        // Uniform on the sphere: the mean is the centre.
+        assert!(close(mean / n as f64, s.center(), 0.02));
+    }
+}
