@@ -106,32 +106,44 @@ fn bench_build(c: &mut Criterion) {
 }
 
 fn bench_trace(c: &mut Criterion) {
+    let pools = [(1usize, pool(1)), (2, pool(2))];
+    let coherent = coherent_rays();
+    let scenes: Vec<(&str, SceneGeometry, Vec<Ray>)> = SIZES
+        .iter()
+        .map(|&(name, n)| {
+            let scene = SceneGeometry::new(mesh_shapes(n)).unwrap();
+            let incoherent = incoherent_rays(&scene, 65_536);
+            (name, scene, incoherent)
+        })
+        .collect();
+
     let mut g = c.benchmark_group("closest_hit");
     g.sample_size(10)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
-    let pools = [(1usize, pool(1)), (2, pool(2))];
-    let coherent = coherent_rays();
-    for (name, n) in SIZES {
-        let scene = SceneGeometry::new(mesh_shapes(n)).unwrap();
-        let incoherent = incoherent_rays(&scene, 65_536);
-        for (kind, rays) in [("coherent", &coherent), ("incoherent", &incoherent)] {
+    for (name, scene, incoherent) in &scenes {
+        for (kind, rays) in [("coherent", &coherent), ("incoherent", incoherent)] {
             g.throughput(Throughput::Elements(rays.len() as u64));
             for (threads, p) in &pools {
                 g.bench_function(
                     BenchmarkId::new(format!("{name}/{kind}"), format!("{threads}_threads")),
-                    |b| b.iter(|| p.install(|| trace(&scene, black_box(rays)))),
+                    |b| b.iter(|| p.install(|| trace(scene, black_box(rays)))),
                 );
             }
         }
+    }
+    g.finish();
+
+    let mut g = c.benchmark_group("occluded");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    for (name, scene, incoherent) in &scenes {
         g.throughput(Throughput::Elements(incoherent.len() as u64));
         for (threads, p) in &pools {
             g.bench_function(
-                BenchmarkId::new(
-                    format!("occluded/{name}/incoherent"),
-                    format!("{threads}_threads"),
-                ),
-                |b| b.iter(|| p.install(|| occluded(&scene, black_box(&incoherent)))),
+                BenchmarkId::new(format!("{name}/incoherent"), format!("{threads}_threads")),
+                |b| b.iter(|| p.install(|| occluded(scene, black_box(incoherent)))),
             );
         }
     }

@@ -92,8 +92,9 @@ impl BuildPrim {
 
 impl Bvh {
     /// Builds the hierarchy over primitives with boxes `bounds` (index `i` = primitive
-    /// `i`). Empty boxes are allowed (such primitives are never reached). At most
-    /// `u32::MAX` primitives.
+    /// `i`). Empty boxes (and boxes with NaN bounds) are allowed: such primitives keep a
+    /// slot but add nothing to any node's box. At most `u32::MAX` primitives (the caller
+    /// checks; [`SceneGeometry`](super::SceneGeometry) does).
     pub fn build(bounds: &[Bounds3]) -> Bvh {
         if bounds.is_empty() {
             return Bvh::default();
@@ -102,13 +103,7 @@ impl Bvh {
             .par_iter()
             .enumerate()
             .map(|(i, b)| BuildPrim {
-                bounds: if b.is_empty() {
-                    // A point at the origin with no extent: it keeps a place in the order
-                    // but its leaf box cannot be hit unless shared with real primitives.
-                    Bounds3::EMPTY
-                } else {
-                    *b
-                },
+                bounds: if b.is_empty() { Bounds3::EMPTY } else { *b },
                 index: i as u32,
             })
             .collect();
