@@ -60,22 +60,29 @@ pub fn check_range(name: &str, value: f64, lo: f64, hi: f64, bounds: Bounds) -> 
             value,
         });
     }
-    let (l, h) = (crate::math::fmt_num(lo), crate::math::fmt_num(hi));
-    let (ok, expected) = match bounds {
-        Bounds::Open => (value > lo && value < hi, format!("{l} < {name} < {h}")),
-        Bounds::Closed => (value >= lo && value <= hi, format!("{l} <= {name} <= {h}")),
-        Bounds::OpenClosed => (value > lo && value <= hi, format!("{l} < {name} <= {h}")),
-        Bounds::ClosedOpen => (value >= lo && value < hi, format!("{l} <= {name} < {h}")),
+    let ok = match bounds {
+        Bounds::Open => value > lo && value < hi,
+        Bounds::Closed => value >= lo && value <= hi,
+        Bounds::OpenClosed => value > lo && value <= hi,
+        Bounds::ClosedOpen => value >= lo && value < hi,
     };
     if ok {
-        Ok(value)
-    } else {
-        Err(ParamError::OutOfRange {
-            name: name.into(),
-            value,
-            expected,
-        })
+        return Ok(value);
     }
+    // The message is formatted only on failure: materials are rebuilt per shading point
+    // when textured.
+    let (l, h) = (crate::math::fmt_num(lo), crate::math::fmt_num(hi));
+    let expected = match bounds {
+        Bounds::Open => format!("{l} < {name} < {h}"),
+        Bounds::Closed => format!("{l} <= {name} <= {h}"),
+        Bounds::OpenClosed => format!("{l} < {name} <= {h}"),
+        Bounds::ClosedOpen => format!("{l} <= {name} < {h}"),
+    };
+    Err(ParamError::OutOfRange {
+        name: name.into(),
+        value,
+        expected,
+    })
 }
 
 #[cfg(test)]

@@ -267,3 +267,228 @@ fn bad_materials_are_clear_errors_with_nonzero_exit() {
         assert!(stderr(&o).contains(needle), "{m}: {}", stderr(&o));
     }
 }
+
+const TINY_SCENE: &str = r#"
+[camera]
+position = [0, 0, 4]
+target = [0, 0, 0]
+fov = 40
+
+[film]
+width = 24
+height = 16
+spp = 8
+
+[[objects]]
+shape = "sphere"
+radius = 1
+material = { type = "il", kd = [0.8, 0.4, 0.2], ni = 1.5, alpha = 0.3 }
+
+[[lights]]
+type = "point"
+position = [2, 2, 3]
+intensity = 10
+
+[[lights]]
+type = "constant"
+radiance = 0.5
+"#;
+
+#[test]
+fn render_writes_exr_and_png_and_prints_a_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(&scene, TINY_SCENE).unwrap();
+    let exr = dir.path().join("out.exr");
+    let o = facette(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            exr.to_str().unwrap(),
+            "--seed",
+            "3",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = stderr(&o);
+    assert!(
+        summary.contains("24×16, 8 spp")
+            && summary.contains("Msamples/s")
+            && summary.contains("0 discarded"),
+        "{summary}"
+    );
+    let img = facette_render::image::read_image(&exr, facette_render::image::ColorEncoding::Linear)
+        .unwrap();
+    assert_eq!((img.width(), img.height()), (24, 16));
+    assert!(img
+        .data()
+        .iter()
+        .flatten()
+        .all(|v| v.is_finite() && *v >= 0.0));
+    // Centre pixel: the lit sphere; corner: the 0.5 background.
+    assert!(img.get(12, 8)[0] > img.get(12, 8)[2]);
+    assert!((img.get(0, 0)[1] - 0.5).abs() < 1e-6);
+    // Same seed, same image; PNG by extension; --spp overrides the scene.
+    let png = dir.path().join("out.png");
+    let o = facette(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--threads",
+            "1",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("2 spp"));
+    let p = facette_render::image::read_image(&png, facette_render::image::ColorEncoding::Srgb)
+        .unwrap();
+    assert_eq!((p.width(), p.height()), (24, 16));
+    let again = dir.path().join("again.exr");
+    let o = facette(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            again.to_str().unwrap(),
+            "--seed",
+            "3",
+            "--threads",
+            "1",
+        ],
+        None,
+    );
+    assert!(o.status.success());
+    let img2 =
+        facette_render::image::read_image(&again, facette_render::image::ColorEncoding::Linear)
+            .unwrap();
+    assert_eq!(
+        img.data(),
+        img2.data(),
+        "same seed, different thread count: different image"
+    );
+}
+
+#[test]
+fn render_errors_leave_existing_outputs_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("keep.png");
+    std::fs::write(&out, b"previous render").unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, TINY_SCENE.replace("alpha = 0.3", "alpha = -0.3")).unwrap();
+    let o = facette(
+        &["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        None,
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("bad.toml:15:") && e.contains("alpha"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous render");
+    // Unsupported output extension, missing directory, missing scene: errors before rendering.
+    let good = dir.path().join("good.toml");
+    std::fs::write(&good, TINY_SCENE).unwrap();
+    let o = facette(&["render", good.to_str().unwrap(), "-o", "x.jpg"], None);
+    assert!(
+        stderr(&o).contains("unsupported image extension `.jpg`; valid: .exr, .png"),
+        "{}",
+        stderr(&o)
+    );
+    let o = facette(
+        &[
+            "render",
+            good.to_str().unwrap(),
+            "-o",
+            dir.path().join("no/such/dir.exr").to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
+    let o = facette(
+        &[
+            "render",
+            dir.path().join("none.toml").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        stderr(&o).contains("cannot read the scene file"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous render");
+}
+
+#[test]
+fn render_time_limit_and_interrupt_write_the_image_so_far() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("slow.toml");
+    std::fs::write(
+        &scene,
+        TINY_SCENE
+            .replace("width = 24", "width = 96")
+            .replace("height = 16", "height = 64"),
+    )
+    .unwrap();
+    let out = dir.path().join("limited.exr");
+    let start = std::time::Instant::now();
+    let o = facette(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "1000000",
+            "--time-limit",
+            "1",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(start.elapsed().as_secs_f64() < 30.0);
+    assert!(stderr(&o).contains("interrupted"), "{}", stderr(&o));
+    let img = facette_render::image::read_image(&out, facette_render::image::ColorEncoding::Linear)
+        .unwrap();
+    assert!(img.data().iter().flatten().all(|v| v.is_finite()));
+    assert!(
+        img.data().iter().all(|p| p[1] > 0.0),
+        "every pixel has samples"
+    );
+
+    // SIGINT: the render stops, writes what it has and exits with 130.
+    let out = dir.path().join("interrupted.exr");
+    let child = Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--spp",
+            "1000000",
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    assert!(stderr(&o).contains("interrupted"), "{}", stderr(&o));
+    let img = facette_render::image::read_image(&out, facette_render::image::ColorEncoding::Linear)
+        .unwrap();
+    assert_eq!((img.width(), img.height()), (96, 64));
+    assert!(img.data().iter().flatten().all(|v| v.is_finite()));
+}

@@ -7,6 +7,20 @@
 //!   the BVH.
 //! - [`image`]: image files (EXR, PNG, HDR) in and out, mip-mapped textures, environment maps
 //!   with importance sampling, the procedural sky.
+//! - [`scene`]: the TOML scene format and its loading (errors with file:line).
+//! - [`camera`], [`film`], [`lights`], [`materials`]: what a scene is made of.
+//! - [`integrator`]: the path tracer (NEE + MIS, Russian roulette).
+//! - [`render`]: tiles in parallel, passes, interruption, determinism.
 
+// `!(x > 0.0)` is the NaN-rejecting test used throughout (a NaN must fail every check).
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod camera;
+pub mod film;
 pub mod geometry;
 pub mod image;
+pub mod integrator;
+pub mod lights;
+pub mod materials;
+pub mod render;
+pub mod scene;

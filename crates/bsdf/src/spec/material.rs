@@ -32,6 +32,29 @@ pub const MATERIAL_TYPES: &[&str] = &[
     "il",
 ];
 
+/// The keys of each material type besides `type` (and the microfacet keys where the type
+/// has a microfacet lobe): checked before anything else, so that a misspelt key is reported
+/// as unknown, with the valid ones, rather than as a missing required key.
+const LAMBERT_KEYS: &[&str] = &["reflectance"];
+const OREN_NAYAR_KEYS: &[&str] = &["reflectance", "sigma", "model", "evaluation", "samples"];
+const CONDUCTOR_KEYS: &[&str] = &["material", "eta", "k", "fresnel", "specular_reflectance"];
+const DIELECTRIC_KEYS: &[&str] = &[
+    "ior",
+    "ext_ior",
+    "preset",
+    "specular_reflectance",
+    "specular_transmittance",
+];
+const KELEMEN_KEYS: &[&str] = &[
+    "distribution",
+    "alpha",
+    "exponent",
+    "ior",
+    "kd",
+    "table_samples",
+];
+const IL_KEYS: &[&str] = &["kd", "ni", "evaluation", "samples", "table", "scattering"];
+
 fn keys(extra: &[&'static str], micro: bool) -> Vec<&'static str> {
     let mut v = vec!["type"];
     if micro {
@@ -131,10 +154,22 @@ impl MaterialRecipe {
         };
         let p = Params::new(table, format!("material \"{ty}\""));
         p.str("type")?;
+        let known = match ty {
+            "lambert" | "diffuse" => Some(keys(LAMBERT_KEYS, false)),
+            "oren-nayar" => Some(keys(OREN_NAYAR_KEYS, false)),
+            "conductor" => Some(keys(CONDUCTOR_KEYS, true)),
+            "dielectric" => Some(keys(DIELECTRIC_KEYS, true)),
+            "kelemen" => Some(keys(KELEMEN_KEYS, false)),
+            "il" | "interfaced-lambertian" => Some(keys(IL_KEYS, true)),
+            _ => None,
+        };
+        if let Some(known) = known {
+            p.check_known(&known)?;
+        }
         match ty {
             "lambert" | "diffuse" => {
                 let r = p.spectrum("reflectance")?.unwrap_or(Spectrum::splat(0.5));
-                p.finish(&keys(&["reflectance"], false))?;
+                p.finish(&keys(LAMBERT_KEYS, false))?;
                 Lambert::new(r)?;
                 Ok(MaterialRecipe::Lambert { reflectance: r })
             }
@@ -402,10 +437,7 @@ fn build_oren_nayar(p: &Params) -> ParamResult<MaterialRecipe> {
     let (model, evaluation) = match p.str("model")?.unwrap_or("exact") {
         "exact" => {
             let ev = parse_evaluation(p, 256)?;
-            p.finish(&keys(
-                &["reflectance", "sigma", "model", "evaluation", "samples"],
-                false,
-            ))?;
+            p.finish(&keys(OREN_NAYAR_KEYS, false))?;
             (OrenNayarModel::Exact, ev)
         }
         "qualitative" => {
@@ -484,10 +516,7 @@ fn build_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
         0.0,
         1.0,
     )?;
-    p.finish(&keys(
-        &["material", "eta", "k", "fresnel", "specular_reflectance"],
-        true,
-    ))?;
+    p.finish(&keys(CONDUCTOR_KEYS, true))?;
     let lobe = match ndf {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
@@ -567,16 +596,7 @@ fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
         0.0,
         1.0,
     )?;
-    p.finish(&keys(
-        &[
-            "ior",
-            "ext_ior",
-            "preset",
-            "specular_reflectance",
-            "specular_transmittance",
-        ],
-        true,
-    ))?;
+    p.finish(&keys(DIELECTRIC_KEYS, true))?;
     let lobe = match ndf {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
@@ -639,10 +659,7 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<MaterialRecip
             "`table` applies to evaluation = \"table\"".into(),
         ));
     }
-    p.finish(&keys(
-        &["kd", "ni", "evaluation", "samples", "table", "scattering"],
-        true,
-    ))?;
+    p.finish(&keys(IL_KEYS, true))?;
     let lobe = match ndf {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
@@ -668,17 +685,7 @@ fn build_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let ior = check_ior(p.f64_or("ior", 1.5)?)?;
     let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
     let samples = p.usize("table_samples")?.unwrap_or(16384);
-    p.finish(&keys(
-        &[
-            "distribution",
-            "alpha",
-            "exponent",
-            "ior",
-            "kd",
-            "table_samples",
-        ],
-        false,
-    ))?;
+    p.finish(&keys(KELEMEN_KEYS, false))?;
     Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::new(
         density,
         Fresnel::Dielectric { eta: ior },

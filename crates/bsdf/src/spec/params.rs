@@ -126,6 +126,18 @@ impl<'a> Params<'a> {
     }
 
     /// Errors on any key not read so far, listing `valid`.
+    /// Fails on the first key of the table that is not in `valid` (before any is read).
+    pub fn check_known(&self, valid: &[&str]) -> ParamResult<()> {
+        match self.table.keys().find(|k| !valid.contains(&k.as_str())) {
+            Some(key) => Err(ParamError::UnknownKey {
+                key: key.clone(),
+                context: self.context.clone(),
+                valid: valid.join(", "),
+            }),
+            None => Ok(()),
+        }
+    }
+
     pub fn finish(&self, valid: &[&str]) -> ParamResult<()> {
         let used = self.used.borrow();
         for key in self.table.keys() {

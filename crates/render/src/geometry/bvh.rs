@@ -36,6 +36,7 @@ use super::bounds::Bounds3;
 use super::ray::Ray;
 use super::Vec3;
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 
 /// Number of SAH buckets per axis.
 pub const BINS: usize = 16;
@@ -166,7 +167,9 @@ impl Bvh {
         let rb = RayBox::new(ray);
         let mut t_max = ray.t_max;
         let mut best = None;
-        let mut stack = [0u32; STACK_SIZE];
+        // Uninitialized: zeroing 512 bytes per ray cost ~3 % of a render. Every read below
+        // pops an entry pushed before it.
+        let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK_SIZE];
         let mut sp = 0;
         let mut idx = 0usize;
         loop {
@@ -175,10 +178,10 @@ impl Bvh {
                 if node.count == 0 {
                     let second = idx + node.offset as usize;
                     if rb.neg[node.axis as usize] {
-                        stack[sp] = (idx + 1) as u32;
+                        stack[sp].write((idx + 1) as u32);
                         idx = second;
                     } else {
-                        stack[sp] = second as u32;
+                        stack[sp].write(second as u32);
                         idx += 1;
                     }
                     sp += 1;
@@ -198,7 +201,8 @@ impl Bvh {
                 break;
             }
             sp -= 1;
-            idx = stack[sp] as usize;
+            // SAFETY: entries 0..sp were written by the pushes above.
+            idx = unsafe { stack[sp].assume_init() } as usize;
         }
         best
     }
@@ -211,7 +215,9 @@ impl Bvh {
         }
         let rb = RayBox::new(ray);
         let t_max = ray.t_max;
-        let mut stack = [0u32; STACK_SIZE];
+        // Uninitialized: zeroing 512 bytes per ray cost ~3 % of a render. Every read below
+        // pops an entry pushed before it.
+        let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK_SIZE];
         let mut sp = 0;
         let mut idx = 0usize;
         loop {
@@ -220,10 +226,10 @@ impl Bvh {
                 if node.count == 0 {
                     let second = idx + node.offset as usize;
                     if rb.neg[node.axis as usize] {
-                        stack[sp] = (idx + 1) as u32;
+                        stack[sp].write((idx + 1) as u32);
                         idx = second;
                     } else {
-                        stack[sp] = second as u32;
+                        stack[sp].write(second as u32);
                         idx += 1;
                     }
                     sp += 1;
@@ -240,7 +246,8 @@ impl Bvh {
                 return false;
             }
             sp -= 1;
-            idx = stack[sp] as usize;
+            // SAFETY: entries 0..sp were written by the pushes above.
+            idx = unsafe { stack[sp].assume_init() } as usize;
         }
     }
 }

@@ -253,3 +253,57 @@ mod tests {
         }
     }
 }
+
+/// The cube [−1, 1]³ with flat faces (24 vertices with face normals and uvs, 12 triangles,
+/// counter-clockwise seen from outside), as Mitsuba 3's `cube` shape.
+pub fn cube_mesh_data() -> MeshData {
+    let mut data = MeshData {
+        normals: Some(Vec::new()),
+        uvs: Some(Vec::new()),
+        ..Default::default()
+    };
+    // For each face: its normal and two tangents with t1 × t2 = n.
+    let faces = [
+        (Vec3::X, Vec3::Y, Vec3::Z),
+        (-Vec3::X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::Z, Vec3::X),
+        (-Vec3::Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (-Vec3::Z, Vec3::Y, Vec3::X),
+    ];
+    for (n, t1, t2) in faces {
+        debug_assert!((t1.cross(t2) - n).length() < 1e-12);
+        let base = data.positions.len() as u32;
+        for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            data.positions.push(n + t1 * a + t2 * b);
+            data.normals.as_mut().expect("set").push(n);
+            data.uvs
+                .as_mut()
+                .expect("set")
+                .push(Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0)));
+        }
+        data.indices
+            .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    data
+}
+
+#[cfg(test)]
+mod cube_tests {
+    use super::*;
+
+    #[test]
+    fn cube_faces_wind_outward_and_enclose_volume_eight() {
+        let d = cube_mesh_data();
+        assert_eq!(d.triangle_count(), 12);
+        let mut volume = 0.0;
+        for t in d.indices.chunks(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| d.positions[t[k] as usize]);
+            let n = (b - a).cross(c - a);
+            // Outward: the face normal agrees with the stored vertex normal.
+            assert!(n.dot(d.normals.as_ref().unwrap()[t[0] as usize]) > 0.0);
+            volume += a.dot(b.cross(c)) / 6.0;
+        }
+        assert!((volume - 8.0).abs() < 1e-12);
+    }
+}

@@ -38,5 +38,5 @@ pub use exr_file::{read_exr_channels, write_exr_channels, ExrChannels};
 pub use io::{read_image, write_image, ColorEncoding};
 pub use mipmap::{MipMap, WrapMode};
 pub use rgb_image::RgbImage;
-pub use sky::{ensure_sky, generate_sky, SkyParams};
+pub use sky::{ensure_sky, generate_sky, load_or_generate_sky, SkyParams};
 pub use texture::Texture;

@@ -1,0 +1,211 @@
+//! `facette render`: loads a scene, renders it with a progress bar, stops cleanly on Ctrl-C
+//! or a time limit (the image so far is written), writes EXR or PNG atomically and prints a
+//! summary line.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use facette_render::integrator::Strategy;
+use facette_render::render::{render, RenderOptions};
+use facette_render::scene::load_scene;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum StrategyArg {
+    /// Next-event estimation and BSDF sampling combined by MIS (the default).
+    Mis,
+    /// Light sampling only (for testing the estimators).
+    Nee,
+    /// BSDF sampling only (for testing the estimators).
+    Bsdf,
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML; see docs/scene-format.md).
+    scene: PathBuf,
+    /// Output image: `.exr` (linear float) or `.png` (sRGB, 8 bit, film exposure applied).
+    /// Defaults to the scene's name with `.exr`, in the current directory.
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Samples per pixel (overrides the scene's film `spp`).
+    #[arg(long)]
+    spp: Option<usize>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Seed of the random streams: the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Stop after this many seconds and write the image rendered so far.
+    #[arg(long, value_name = "SECS")]
+    time_limit: Option<f64>,
+    /// Exposure in stops (overrides the scene's film `exposure`).
+    #[arg(long)]
+    exposure: Option<f64>,
+    /// Which estimators to use.
+    #[arg(long, value_enum, default_value = "mis")]
+    strategy: StrategyArg,
+    /// No progress bar and no summary.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+pub fn run(a: RenderArgs) -> Result<ExitCode> {
+    let output = a.output.clone().unwrap_or_else(|| {
+        let stem = a
+            .scene
+            .file_stem()
+            .map(|s| s.to_os_string())
+            .unwrap_or_else(|| "render".into());
+        PathBuf::from(stem).with_extension("exr")
+    });
+    check_output(&output)?;
+    if let Some(s) = a.spp {
+        if s == 0 {
+            bail!("--spp must be at least 1");
+        }
+    }
+    if let Some(t) = a.threads {
+        if t == 0 {
+            bail!("--threads must be at least 1");
+        }
+    }
+    if let Some(t) = a.time_limit {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time-limit must be a positive number of seconds, got {t}");
+        }
+    }
+    if let Some(e) = a.exposure {
+        if !e.is_finite() {
+            bail!("--exposure must be a finite number of stops, got {e}");
+        }
+    }
+
+    let load_start = Instant::now();
+    let scene = load_scene(&a.scene)?;
+    let load_secs = load_start.elapsed().as_secs_f64();
+    let spp = a.spp.unwrap_or(scene.film.spp);
+    let (w, h) = (scene.film.width, scene.film.height);
+
+    let cancel = Arc::new(AtomicBool::new(false));
+    {
+        let cancel = cancel.clone();
+        // A second Ctrl-C exits at once (nothing is written; the previous output stays).
+        let res = ctrlc::set_handler(move || {
+            if cancel.swap(true, Ordering::SeqCst) {
+                eprintln!("\ninterrupted twice: exiting without writing");
+                std::process::exit(130);
+            }
+            eprintln!("\nstopping: finishing the tiles in flight, then writing the image so far (Ctrl-C again to abort)");
+        });
+        if let Err(e) = res {
+            eprintln!(
+                "warning: Ctrl-C handler not installed ({e}); Ctrl-C will abort without writing"
+            );
+        }
+    }
+
+    let pb = ProgressBar::new((w * h * spp) as u64);
+    if a.quiet || !std::io::stderr().is_terminal() {
+        pb.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    pb.set_style(
+        ProgressStyle::with_template(
+            "rendering [{bar:40}] {percent:>3}% {msg} elapsed {elapsed} eta {eta}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let start = Instant::now();
+    let progress = |done: u64, total: u64| {
+        pb.set_length(total);
+        pb.set_position(done);
+        let secs = start.elapsed().as_secs_f64().max(1e-9);
+        pb.set_message(format!("{:.2} Msamples/s", done as f64 / secs / 1e6));
+    };
+    let opts = RenderOptions {
+        spp: Some(spp),
+        seed: a.seed,
+        threads: a.threads,
+        time_limit: a.time_limit,
+        part: None,
+        strategy: match a.strategy {
+            StrategyArg::Mis => Strategy::Mis,
+            StrategyArg::Nee => Strategy::NeeOnly,
+            StrategyArg::Bsdf => Strategy::BsdfOnly,
+        },
+    };
+    let (film, stats) = render(&scene, &opts, &cancel, &progress).map_err(anyhow::Error::msg)?;
+    pb.finish_and_clear();
+
+    let exposure = a.exposure.unwrap_or(scene.film.exposure);
+    let image = film.image();
+    facette_render::image::write_image(&output, &image, exposure)
+        .with_context(|| format!("writing {}", output.display()))?;
+
+    let empty = film.counts.iter().filter(|&&c| c == 0).count();
+    if !a.quiet {
+        let samples = stats.samples;
+        let mean_spp = samples as f64 / (w * h) as f64;
+        let mut line = format!(
+            "{} ({w}×{h}, {} spp{}): scene loaded in {load_secs:.2} s ({} primitives), rendered in {:.2} s, {:.2} Msamples/s, {} discarded samples (NaN/Inf/negative){}",
+            output.display(),
+            if stats.interrupted { format!("{mean_spp:.1} of {spp}") } else { spp.to_string() },
+            if stats.interrupted { ", interrupted" } else { "" },
+            scene.geometry.primitive_count(),
+            stats.seconds,
+            stats.msamples_per_second(),
+            stats.discarded,
+            if empty > 0 { format!(", {empty} pixels without samples (black)") } else { String::new() },
+        );
+        if stats.discarded > 0 {
+            line.push_str(&format!(
+                " = {:.2e} of all samples",
+                stats.discarded as f64 / samples.max(1) as f64
+            ));
+        }
+        eprintln!("{line}");
+    }
+    Ok(if cancel.load(Ordering::SeqCst) {
+        ExitCode::from(130)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Fails before rendering when the output could not be written: an unknown extension or a
+/// missing directory.
+fn check_output(path: &Path) -> Result<()> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("exr") | Some("png") => {}
+        Some(e) => bail!(
+            "-o {}: unsupported image extension `.{e}`; valid: .exr, .png",
+            path.display()
+        ),
+        None => bail!(
+            "-o {}: the output needs an extension, .exr or .png",
+            path.display()
+        ),
+    }
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        bail!(
+            "-o {}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}

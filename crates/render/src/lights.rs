@@ -1,0 +1,341 @@
+//! Lights: point, spot and directional (delta) lights, area lights (emissive shapes) and
+//! the environment (an importance-sampled map, or a constant radiance). Lights are chosen
+//! for next-event estimation in proportion to an estimate of their power.
+
+use crate::geometry::{Ray, SceneGeometry, Vec2, Vec3};
+use crate::image::{ConstantEnvironment, EnvironmentMap};
+use facette_bsdf::math::Frame;
+use facette_bsdf::Spectrum;
+use std::f64::consts::PI;
+
+/// An environment: a map or a constant radiance, looked up by world direction.
+#[derive(Clone, Debug)]
+pub enum Environment {
+    Map(Box<EnvironmentMap>),
+    Constant(ConstantEnvironment),
+}
+
+impl Environment {
+    #[inline]
+    pub fn eval(&self, d: Vec3) -> Spectrum {
+        match self {
+            Environment::Map(m) => m.eval(d),
+            Environment::Constant(c) => c.eval(d),
+        }
+    }
+
+    #[inline]
+    pub fn pdf(&self, d: Vec3) -> f64 {
+        match self {
+            Environment::Map(m) => m.pdf(d),
+            Environment::Constant(c) => c.pdf(d),
+        }
+    }
+
+    /// (direction, radiance, solid-angle pdf).
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> Option<(Vec3, Spectrum, f64)> {
+        let s = match self {
+            Environment::Map(m) => m.sample(u),
+            Environment::Constant(c) => c.sample(u),
+        }?;
+        Some((s.direction, s.radiance, s.pdf))
+    }
+
+    pub fn mean_radiance(&self) -> Spectrum {
+        match self {
+            Environment::Map(m) => m.mean_radiance(),
+            Environment::Constant(c) => c.mean_radiance(),
+        }
+    }
+}
+
+/// A light of the scene.
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// Isotropic point light of intensity I (W/sr per channel).
+    Point { position: Vec3, intensity: Spectrum },
+    /// Spot light: intensity I along `frame.n`, full up to `beam` (radians), falling off
+    /// linearly in angle to zero at `cutoff` (Mitsuba 3's `spot`).
+    Spot {
+        position: Vec3,
+        frame: Frame,
+        intensity: Spectrum,
+        cutoff: f64,
+        beam: f64,
+    },
+    /// Distant light arriving along `-direction`… i.e. travelling along `direction`, with
+    /// irradiance E on surfaces facing it.
+    Directional {
+        direction: Vec3,
+        irradiance: Spectrum,
+    },
+    /// An emissive shape: radiance L leaving its front side (both sides if `two_sided`).
+    Area {
+        shape: u32,
+        radiance: Spectrum,
+        two_sided: bool,
+    },
+    /// The environment, seen by rays that leave the scene.
+    Environment(Environment),
+}
+
+/// A light sample for next-event estimation from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point toward the light.
+    pub wi: Vec3,
+    /// Radiance (or, for delta lights, radiant intensity / distance²) arriving along `wi`.
+    pub radiance: Spectrum,
+    /// Solid-angle pdf of `wi` (1 for delta lights).
+    pub pdf: f64,
+    pub delta: bool,
+    /// The shadow ray to test (from the shading point to the light).
+    pub shadow: Ray,
+}
+
+impl Light {
+    pub fn is_delta(&self) -> bool {
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+        )
+    }
+
+    /// Spot falloff for a cosine to the axis.
+    fn spot_falloff(cos: f64, cutoff: f64, beam: f64) -> f64 {
+        let angle = cos.clamp(-1.0, 1.0).acos();
+        if angle <= beam {
+            1.0
+        } else if angle >= cutoff {
+            0.0
+        } else {
+            (cutoff - angle) / (cutoff - beam)
+        }
+    }
+
+    /// Estimate of the emitted power (luminance), for light selection; `radius` is the
+    /// scene's bounding-sphere radius.
+    pub fn power(&self, geometry: &SceneGeometry, radius: f64) -> f64 {
+        match self {
+            Light::Point { intensity, .. } => 4.0 * PI * intensity.luminance(),
+            Light::Spot {
+                intensity,
+                cutoff,
+                beam,
+                ..
+            } => 2.0 * PI * (1.0 - 0.5 * (cutoff.cos() + beam.cos())) * intensity.luminance(),
+            Light::Directional { irradiance, .. } => PI * radius * radius * irradiance.luminance(),
+            Light::Area {
+                shape,
+                radiance,
+                two_sided,
+            } => {
+                let sides = if *two_sided { 2.0 } else { 1.0 };
+                PI * sides * geometry.shape_area(*shape) * radiance.luminance()
+            }
+            Light::Environment(e) => PI * PI * radius * radius * e.mean_radiance().luminance(),
+        }
+        .max(0.0)
+    }
+
+    /// Samples the light from the shading point `p` (geometric normal `ng`, used to offset
+    /// the shadow ray). `scene_radius` bounds the scene for distant lights.
+    pub fn sample(
+        &self,
+        geometry: &SceneGeometry,
+        p: Vec3,
+        ng: Vec3,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        match self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                if dist2 <= 0.0 {
+                    return None;
+                }
+                Some(LightSample {
+                    wi: d / dist2.sqrt(),
+                    radiance: *intensity / dist2,
+                    pdf: 1.0,
+                    delta: true,
+                    shadow: Ray::spawn_to(p, ng, *position),
+                })
+            }
+            Light::Spot {
+                position,
+                frame,
+                intensity,
+                cutoff,
+                beam,
+            } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                if dist2 <= 0.0 {
+                    return None;
+                }
+                let wi = d / dist2.sqrt();
+                let f = Self::spot_falloff((-wi).dot(frame.n), *cutoff, *beam);
+                if f <= 0.0 {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    radiance: *intensity * (f / dist2),
+                    pdf: 1.0,
+                    delta: true,
+                    shadow: Ray::spawn_to(p, ng, *position),
+                })
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                let wi = -*direction;
+                Some(LightSample {
+                    wi,
+                    radiance: *irradiance,
+                    pdf: 1.0,
+                    delta: true,
+                    shadow: Ray::spawn(p, ng, wi),
+                })
+            }
+            Light::Area {
+                shape,
+                radiance,
+                two_sided,
+            } => {
+                let (q, nq, pdf_area) = geometry.sample_shape(*shape, u);
+                if !(pdf_area > 0.0) {
+                    return None;
+                }
+                let d = q - p;
+                let dist2 = d.length_squared();
+                if dist2 <= 0.0 {
+                    return None;
+                }
+                let wi = d / dist2.sqrt();
+                let cos_l = nq.dot(-wi);
+                if cos_l <= 0.0 && !two_sided {
+                    return None;
+                }
+                let cos_l = cos_l.abs();
+                if cos_l <= 1e-12 {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    radiance: *radiance,
+                    pdf: pdf_area * dist2 / cos_l,
+                    delta: false,
+                    shadow: Ray::spawn_between(p, ng, q, nq),
+                })
+            }
+            Light::Environment(e) => {
+                let (wi, radiance, pdf) = e.sample(u)?;
+                if !(pdf > 0.0) {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    radiance,
+                    pdf,
+                    delta: false,
+                    shadow: Ray::spawn(p, ng, wi),
+                })
+            }
+        }
+    }
+
+    /// Solid-angle pdf with which `sample` from `p` produces the direction `wi` that hits
+    /// this (area) light at `q` with normal `nq`.
+    pub fn pdf_area_hit(&self, geometry: &SceneGeometry, p: Vec3, q: Vec3, nq: Vec3) -> f64 {
+        match self {
+            Light::Area {
+                shape, two_sided, ..
+            } => {
+                let d = q - p;
+                let dist2 = d.length_squared();
+                let wi = d / dist2.sqrt();
+                let cos_l = nq.dot(-wi);
+                if cos_l <= 0.0 && !two_sided {
+                    return 0.0;
+                }
+                let area = geometry.shape_area(*shape);
+                if area <= 0.0 || cos_l.abs() <= 1e-12 {
+                    return 0.0;
+                }
+                dist2 / (area * cos_l.abs())
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Radiance leaving an area light's point with normal `n` toward `w`.
+    #[inline]
+    pub fn emitted(&self, n: Vec3, w: Vec3) -> Spectrum {
+        match self {
+            Light::Area {
+                radiance,
+                two_sided,
+                ..
+            } => {
+                if n.dot(w) > 0.0 || *two_sided {
+                    *radiance
+                } else {
+                    Spectrum::ZERO
+                }
+            }
+            _ => Spectrum::ZERO,
+        }
+    }
+}
+
+/// Picks lights in proportion to their power (uniformly when none has power).
+#[derive(Clone, Debug)]
+pub struct LightSelector {
+    cdf: Vec<f64>,
+    probs: Vec<f64>,
+}
+
+impl LightSelector {
+    pub fn new(powers: &[f64]) -> LightSelector {
+        let total: f64 = powers.iter().sum();
+        let n = powers.len();
+        let probs: Vec<f64> = if total > 0.0 && total.is_finite() {
+            powers.iter().map(|p| p / total).collect()
+        } else {
+            vec![1.0 / n.max(1) as f64; n]
+        };
+        let mut cdf = Vec::with_capacity(n);
+        let mut acc = 0.0;
+        for p in &probs {
+            acc += p;
+            cdf.push(acc);
+        }
+        LightSelector { cdf, probs }
+    }
+
+    /// (light index, probability).
+    #[inline]
+    pub fn select(&self, u: f64) -> Option<(usize, f64)> {
+        if self.cdf.is_empty() {
+            return None;
+        }
+        let k = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.cdf.len() - 1);
+        let p = self.probs[k];
+        (p > 0.0).then_some((k, p))
+    }
+
+    #[inline]
+    pub fn probability(&self, k: usize) -> f64 {
+        self.probs.get(k).copied().unwrap_or(0.0)
+    }
+}

@@ -1,0 +1,246 @@
+//! Rendering a scene: square tiles in parallel (rayon), in passes of samples so that an
+//! interruption (Ctrl-C, a time limit) leaves every pixel with a valid mean. Each sample has
+//! its own random stream, PCG32 seeded by (seed, pixel) with the sample index as stream, so
+//! the image depends on the seed only — not on the thread count, the tiling or the passes —
+//! and any subset of samples can be rendered separately and merged exactly.
+
+use crate::film::Film;
+use crate::geometry::Vec2;
+use crate::integrator::{radiance, Strategy};
+use crate::scene::Scene;
+use facette_bsdf::math::rng::{mix_seed, Pcg32, RandomSource};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// How to render.
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    /// Samples per pixel (the scene's when `None`).
+    pub spp: Option<usize>,
+    pub seed: u64,
+    /// Worker threads (all cores when `None`).
+    pub threads: Option<usize>,
+    /// Stop after this many seconds (the image so far is kept).
+    pub time_limit: Option<f64>,
+    /// Render only sample indices `s` with `s % parts.1 == parts.0` (a share of the samples
+    /// for distributed rendering).
+    pub part: Option<(usize, usize)>,
+    pub strategy: Strategy,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            spp: None,
+            seed: 0,
+            threads: None,
+            time_limit: None,
+            part: None,
+            strategy: Strategy::Mis,
+        }
+    }
+}
+
+/// Statistics of a render.
+#[derive(Clone, Debug)]
+pub struct RenderStats {
+    pub samples: u64,
+    pub seconds: f64,
+    pub discarded: u64,
+    pub interrupted: bool,
+}
+
+impl RenderStats {
+    pub fn msamples_per_second(&self) -> f64 {
+        self.samples as f64 / self.seconds.max(1e-9) / 1e6
+    }
+}
+
+const TILE: usize = 32;
+
+/// Samples per pass: 1, 1, 2, 4, … doubling up to a sixteenth of the total, so that a
+/// first image comes fast and the time limit is checked often, while long renders keep few
+/// passes. Depends on the sample count only (the image must not depend on timing).
+fn pass_sizes(n: usize) -> Vec<usize> {
+    let cap = n.div_ceil(16).max(1);
+    let mut sizes = Vec::new();
+    let (mut left, mut next) = (n, 1usize);
+    while left > 0 {
+        let s = next.min(cap).min(left);
+        sizes.push(s);
+        left -= s;
+        if sizes.len() > 1 {
+            next *= 2;
+        }
+    }
+    sizes
+}
+
+/// One pixel's samples of one pass.
+struct PixelSums {
+    sum: [f64; 3],
+    sq: [f64; 3],
+    n: u32,
+    bad: u32,
+}
+
+/// Renders `scene`. `cancel` stops the render between tiles; `progress(done, total)` is
+/// called with sample counts as tiles finish.
+pub fn render(
+    scene: &Scene,
+    opts: &RenderOptions,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<(Film, RenderStats), String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| format!("cannot start the thread pool: {e}"))?;
+    pool.install(|| render_in_pool(scene, opts, cancel, progress))
+}
+
+fn render_in_pool(
+    scene: &Scene,
+    opts: &RenderOptions,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<(Film, RenderStats), String> {
+    let (w, h) = (scene.film.width, scene.film.height);
+    let spp = opts.spp.unwrap_or(scene.film.spp);
+    if spp == 0 {
+        return Err("spp must be at least 1".into());
+    }
+    let (part, parts) = opts.part.unwrap_or((0, 1));
+    if parts == 0 || part >= parts {
+        return Err(format!(
+            "part {part}/{parts}: the part index must be below the part count"
+        ));
+    }
+    // The sample indices this render takes.
+    let indices: Vec<u32> = (0..spp as u32)
+        .filter(|s| *s as usize % parts == part)
+        .collect();
+    let total = (indices.len() * w * h) as u64;
+    let passes = pass_sizes(indices.len());
+    let tiles: Vec<(usize, usize)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
+        .collect();
+    let mut film = Film::new(w, h);
+    let start = Instant::now();
+    let deadline = opts
+        .time_limit
+        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    let done = AtomicU64::new(0);
+    let stop = AtomicBool::new(false);
+    // Whether to stop now. The time limit never cuts the first pass, so that every pixel
+    // gets samples; Ctrl-C does.
+    let should_stop = |pass: usize| {
+        if cancel.load(Ordering::Relaxed) || stop.load(Ordering::Relaxed) {
+            return true;
+        }
+        if let (Some(d), true) = (deadline, pass > 0) {
+            if Instant::now() >= d {
+                stop.store(true, Ordering::Relaxed);
+                return true;
+            }
+        }
+        false
+    };
+    let diff_scale = 1.0 / (spp as f64).sqrt().max(1.0);
+    let mut first = 0;
+    for (pass, size) in passes.into_iter().enumerate() {
+        let chunk = &indices[first..first + size];
+        first += size;
+        if should_stop(pass) {
+            break;
+        }
+        let results: Vec<(usize, usize, Vec<PixelSums>)> = tiles
+            .par_iter()
+            .map(|&(tx, ty)| {
+                let x0 = tx * TILE;
+                let y0 = ty * TILE;
+                let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+                let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
+                for y in y0..y1 {
+                    // Checked per row: a pass of many samples is stopped promptly; the rows
+                    // left out keep the samples of the earlier passes.
+                    if should_stop(pass) {
+                        break;
+                    }
+                    for x in x0..x1 {
+                        let pixel = (y * w + x) as u64;
+                        let mut p = PixelSums {
+                            sum: [0.0; 3],
+                            sq: [0.0; 3],
+                            n: 0,
+                            bad: 0,
+                        };
+                        for &s in chunk {
+                            let mut rng = Pcg32::new(mix_seed(opts.seed, pixel), s as u64);
+                            let off = scene.film.filter.sample(rng.next_2d());
+                            let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
+                            let lens = rng.next_2d();
+                            let (ray, rd) =
+                                scene.camera.generate_ray(fx, fy, Vec2::new(lens.x, lens.y));
+                            let rd = rd.scaled(&ray, diff_scale);
+                            let l = radiance(scene, ray, Some(rd), &mut rng, opts.strategy);
+                            p.n += 1;
+                            if l.is_finite() && !l.has_negative() {
+                                for c in 0..3 {
+                                    p.sum[c] += l[c];
+                                    p.sq[c] += l[c] * l[c];
+                                }
+                            } else {
+                                p.bad += 1;
+                            }
+                        }
+                        out.push(p);
+                    }
+                    let row = ((x1 - x0) * chunk.len()) as u64;
+                    let d = done.fetch_add(row, Ordering::Relaxed) + row;
+                    progress(d, total);
+                }
+                (tx, ty, out)
+            })
+            .collect();
+        for (tx, ty, px) in results {
+            let (x0, y0) = (tx * TILE, ty * TILE);
+            let x1 = (x0 + TILE).min(w);
+            for (k, p) in px.into_iter().enumerate() {
+                let (x, y) = (x0 + k % (x1 - x0), y0 + k / (x1 - x0));
+                let i = y * w + x;
+                for c in 0..3 {
+                    film.sums[i][c] += p.sum[c];
+                    film.sq_sums[i][c] += p.sq[c];
+                }
+                film.counts[i] += p.n;
+                film.discarded += p.bad as u64;
+            }
+        }
+    }
+    let stats = RenderStats {
+        samples: film.total_samples(),
+        seconds: start.elapsed().as_secs_f64(),
+        discarded: film.discarded,
+        interrupted: cancel.load(Ordering::Relaxed) || stop.load(Ordering::Relaxed),
+    };
+    Ok((film, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pass_sizes;
+
+    #[test]
+    fn passes_start_small_double_and_cover_every_sample() {
+        assert_eq!(pass_sizes(1), vec![1]);
+        assert_eq!(pass_sizes(8), vec![1; 8]);
+        assert_eq!(pass_sizes(64), [vec![1, 1, 2, 4], vec![4; 14]].concat());
+        for n in [0, 1, 7, 100, 4096, 1_000_000] {
+            let p = pass_sizes(n);
+            assert_eq!(p.iter().sum::<usize>(), n);
+            assert!(p.len() <= 16 + 2 + (n.max(1) as f64).log2() as usize);
+        }
+    }
+}
