@@ -42,6 +42,26 @@ const MODELS: &[(&str, &str)] = &[
         "kelemen-ward",
         r#"{type = "kelemen", alpha = 0.3, kd = 0.5}"#,
     ),
+    (
+        "il-flat",
+        r#"{type = "il", kd = 0.6, ni = 1.5, alpha = 0}"#,
+    ),
+    (
+        "il-stochastic",
+        r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3}"#,
+    ),
+    (
+        "il-quadrature-1024",
+        r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3, evaluation = "quadrature"}"#,
+    ),
+    (
+        "il-approx",
+        r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3, masking = "v-cavity", evaluation = "approx"}"#,
+    ),
+    (
+        "il-multiple",
+        r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3, masking = "v-cavity", scattering = "multiple"}"#,
+    ),
 ];
 
 fn models(c: &mut Criterion) {
