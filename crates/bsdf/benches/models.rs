@@ -42,10 +42,7 @@ const MODELS: &[(&str, &str)] = &[
         "kelemen-ward",
         r#"{type = "kelemen", alpha = 0.3, kd = 0.5}"#,
     ),
-    (
-        "il-flat",
-        r#"{type = "il", kd = 0.6, ni = 1.5, alpha = 0}"#,
-    ),
+    ("il-flat", r#"{type = "il", kd = 0.6, ni = 1.5, alpha = 0}"#),
     (
         "il-stochastic",
         r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3}"#,

@@ -51,21 +51,43 @@ pub struct RenderArgs {
     /// Which estimators to use.
     #[arg(long, value_enum, default_value = "mis")]
     strategy: StrategyArg,
+    /// Render part K of N of the samples (K from 0) and write the exact partial result to
+    /// a `.fcpart` file for `facette merge` (distributed rendering; see docs/scale-out.md).
+    #[arg(long, value_name = "K/N")]
+    part: Option<String>,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
 }
 
+/// Parses `K/N` with 0 ≤ K < N.
+pub fn parse_part(s: &str) -> Result<(u32, u32)> {
+    let parsed = s
+        .split_once('/')
+        .and_then(|(k, n)| Some((k.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((k, n)) if n > 0 && k < n => Ok((k, n)),
+        _ => bail!("--part {s}: expected K/N with 0 ≤ K < N, e.g. 0/8"),
+    }
+}
+
 pub fn run(a: RenderArgs) -> Result<ExitCode> {
+    let part = a.part.as_deref().map(parse_part).transpose()?;
     let output = a.output.clone().unwrap_or_else(|| {
         let stem = a
             .scene
             .file_stem()
-            .map(|s| s.to_os_string())
+            .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "render".into());
-        PathBuf::from(stem).with_extension("exr")
+        match part {
+            Some((k, n)) => PathBuf::from(format!("{stem}.part{k}of{n}.fcpart")),
+            None => PathBuf::from(stem).with_extension("exr"),
+        }
     });
-    check_output(&output)?;
+    check_output(&output, part.is_some())?;
+    if part.is_some() && a.time_limit.is_some() {
+        bail!("--time-limit cannot be used with --part: a part must hold all its samples for an exact merge");
+    }
     if let Some(s) = a.spp {
         if s == 0 {
             bail!("--spp must be at least 1");
@@ -141,6 +163,28 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
             StrategyArg::Bsdf => Strategy::BsdfOnly,
         },
     };
+    if let Some((k, n)) = part {
+        let res =
+            facette_render::partial_film::render_part(&scene, &opts, k, n, &cancel, &progress);
+        pb.finish_and_clear();
+        if cancel.load(Ordering::SeqCst) {
+            eprintln!("interrupted: part {k}/{n} is incomplete and was not written");
+            return Ok(ExitCode::from(130));
+        }
+        let (partial, stats) = res.map_err(anyhow::Error::msg)?;
+        partial.save(&output)?;
+        if !a.quiet {
+            eprintln!(
+                "{} (part {k}/{n}, {w}×{h}, {} samples of {spp} spp): rendered in {:.2} s, {:.2} Msamples/s, {} discarded samples",
+                output.display(),
+                stats.samples,
+                stats.seconds,
+                stats.msamples_per_second(),
+                stats.discarded
+            );
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     let (film, stats) = render(&scene, &opts, &cancel, &progress).map_err(anyhow::Error::msg)?;
     pb.finish_and_clear();
 
@@ -181,17 +225,21 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
 
 /// Fails before rendering when the output could not be written: an unknown extension or a
 /// missing directory.
-fn check_output(path: &Path) -> Result<()> {
+pub fn check_output(path: &Path, partial: bool) -> Result<()> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
-    match ext.as_deref() {
-        Some("exr") | Some("png") => {}
-        Some(e) => bail!(
+    match (ext.as_deref(), partial) {
+        (Some("exr") | Some("png"), false) | (Some("fcpart"), true) => {}
+        (_, true) => bail!(
+            "-o {}: a part is written to a `.fcpart` file",
+            path.display()
+        ),
+        (Some(e), false) => bail!(
             "-o {}: unsupported image extension `.{e}`; valid: .exr, .png",
             path.display()
         ),
-        None => bail!(
+        (None, false) => bail!(
             "-o {}: the output needs an extension, .exr or .png",
             path.display()
         ),

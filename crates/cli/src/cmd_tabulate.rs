@@ -7,6 +7,7 @@ use clap::Args;
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::models::il_table::BodyTable;
+use facette_bsdf::models::il_table_part::{merge_table_parts, TablePart};
 use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
 use facette_bsdf::spec::{parse_inline_table, Params};
@@ -28,6 +29,10 @@ pub struct TabulateArgs {
     /// Output file (.fctab).
     #[arg(short, long, value_name = "FILE")]
     output: std::path::PathBuf,
+    /// Compute part K of N of the table's rows and write it to a `.fctpart` file for
+    /// `facette merge` (distributed tabulation; see docs/scale-out.md).
+    #[arg(long, value_name = "K/N")]
+    part: Option<String>,
     /// Compare the table with the quadrature on this many random off-grid direction pairs.
     #[arg(long, value_name = "K", default_value_t = 0)]
     check: usize,
@@ -49,6 +54,35 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
         ),
     };
     let lobe = il.lobe().expect("rough").clone();
+    if let Some(part) = &a.part {
+        let (k, n) = crate::cmd_render::parse_part(part)?;
+        if a.output.extension().is_none_or(|e| e != "fctpart") {
+            bail!(
+                "-o {}: a table part is written to a `.fctpart` file",
+                a.output.display()
+            );
+        }
+        if a.check > 0 {
+            bail!("--check applies to whole tables (after `facette merge`)");
+        }
+        let pb = crate::progress::bar(0, "tabulating");
+        let start = Instant::now();
+        let p = TablePart::build(&lobe, il.ni(), a.step, a.samples, k, n, &|done, total| {
+            pb.set_length(total as u64);
+            pb.set_position(done as u64);
+        })
+        .context("tabulate")?;
+        pb.finish_and_clear();
+        p.save(&a.output)
+            .with_context(|| format!("cannot write {}", a.output.display()))?;
+        println!(
+            "wrote {} (part {k}/{n}: {} θ_i rows, {:.2} s)",
+            a.output.display(),
+            p.row_count(),
+            start.elapsed().as_secs_f64()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
     let pb = crate::progress::bar(0, "tabulating");
     let start = Instant::now();
     let t = BodyTable::build(&lobe, il.ni(), a.step, a.samples, &|done, total| {
@@ -134,4 +168,34 @@ fn find_il(table: &toml::Table) -> Result<Option<InterfacedLambertian>> {
         BodyEvaluation::Stochastic,
         Scattering::Single,
     )?))
+}
+
+/// `facette merge` for table parts: all N parts of one table into a `.fctab` file.
+pub fn merge(parts: &[std::path::PathBuf], output: &std::path::Path) -> Result<ExitCode> {
+    if output.extension().is_none_or(|e| e != "fctab") {
+        bail!(
+            "-o {}: table parts merge into a `.fctab` file",
+            output.display()
+        );
+    }
+    let parts: Vec<TablePart> = parts
+        .iter()
+        .map(|p| TablePart::load(p))
+        .collect::<Result<_, _>>()?;
+    let table = merge_table_parts(&parts).map_err(|e| anyhow::anyhow!("cannot merge: {e}"))?;
+    table
+        .save(output)
+        .with_context(|| format!("cannot write {}", output.display()))?;
+    println!(
+        "wrote {} (merged {} parts: {}×{}×{} entries, {} samples each; relative standard error mean {:.2e}, max {:.2e})",
+        output.display(),
+        parts.len(),
+        table.n_theta,
+        table.n_theta,
+        table.n_phi,
+        table.samples,
+        table.mean_stderr,
+        table.max_stderr
+    );
+    Ok(ExitCode::SUCCESS)
 }

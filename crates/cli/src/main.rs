@@ -4,6 +4,7 @@
 mod cmd_albedo;
 mod cmd_eval;
 mod cmd_il_approx;
+mod cmd_merge;
 mod cmd_render;
 mod cmd_tabulate;
 mod cmd_validate;
@@ -31,6 +32,8 @@ struct Cli {
 enum Command {
     /// Render a scene file to EXR or PNG.
     Render(cmd_render::RenderArgs),
+    /// Merge the parts of a distributed render (.fcpart) or table (.fctpart).
+    Merge(cmd_merge::MergeArgs),
     /// Evaluate a material on directions read as CSV (theta_i,phi_i,theta_o,phi_o in degrees).
     Eval(cmd_eval::EvalArgs),
     /// Directional reflectance and transmittance of a material, with standard errors.
@@ -47,6 +50,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(a) => cmd_render::run(a),
+        Command::Merge(a) => cmd_merge::run(a),
         Command::Eval(a) => cmd_eval::run(a),
         Command::Albedo(a) => cmd_albedo::run(a),
         Command::Validate(a) => cmd_validate::run(a),

@@ -492,3 +492,181 @@ fn render_time_limit_and_interrupt_write_the_image_so_far() {
     assert_eq!((img.width(), img.height()), (96, 64));
     assert!(img.data().iter().flatten().all(|v| v.is_finite()));
 }
+
+#[test]
+fn render_parts_merge_exactly_and_bad_sets_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(&scene, TINY_SCENE).unwrap();
+    let s = scene.to_str().unwrap();
+    let part = |k: u32, n: u32, seed: &str| {
+        let out = dir.path().join(format!("p{k}of{n}s{seed}.fcpart"));
+        let o = facette(
+            &[
+                "render",
+                s,
+                "--part",
+                &format!("{k}/{n}"),
+                "--seed",
+                seed,
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        out.to_str().unwrap().to_string()
+    };
+    let parts: Vec<String> = (0..3).rev().map(|k| part(k, 3, "9")).collect();
+    let merged = dir.path().join("merged.exr");
+    let mut args = vec!["merge"];
+    args.extend(parts.iter().map(|p| p.as_str()));
+    args.extend(["-o", merged.to_str().unwrap()]);
+    let o = facette(&args, None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The same three parts rendered in one process.
+    let sc = facette_render::scene::load_scene(&scene).unwrap();
+    let opts = facette_render::render::RenderOptions {
+        seed: 9,
+        ..Default::default()
+    };
+    let film = facette_render::partial_film::render_in_parts(&sc, &opts, 3).unwrap();
+    let got =
+        facette_render::image::read_image(&merged, facette_render::image::ColorEncoding::Linear)
+            .unwrap();
+    assert_eq!(
+        got.data(),
+        film.image().data(),
+        "merged parts differ from the in-process render"
+    );
+    // Statistically the same as a plain render with many more samples.
+    let plain = facette_render::render::render(
+        &sc,
+        &facette_render::render::RenderOptions {
+            spp: Some(96),
+            seed: 1,
+            ..Default::default()
+        },
+        &std::sync::atomic::AtomicBool::new(false),
+        &|_, _| {},
+    )
+    .unwrap()
+    .0;
+    let (a, ea) = film.block_mean(0, 0, 24, 16);
+    let (b, eb) = plain.block_mean(0, 0, 24, 16);
+    for c in 0..3 {
+        assert!(
+            (a[c] - b[c]).abs() < 4.0 * (ea[c].hypot(eb[c])) + 1e-9,
+            "{a:?} ± {ea:?} vs {b:?} ± {eb:?}"
+        );
+    }
+    // Refused: a missing part, a duplicate, another seed, another scene, another N.
+    let bad = |list: Vec<String>, what: &str| {
+        let mut args = vec!["merge".to_string()];
+        args.extend(list);
+        args.extend([
+            "-o".into(),
+            dir.path().join("bad.exr").to_str().unwrap().into(),
+        ]);
+        let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        let o = facette(&args, None);
+        assert_eq!(o.status.code(), Some(1));
+        assert!(
+            stderr(&o).contains(what),
+            "expected `{what}` in: {}",
+            stderr(&o)
+        );
+    };
+    bad(parts[..2].to_vec(), "missing part(s)");
+    bad(
+        vec![parts[0].clone(), parts[0].clone(), parts[1].clone()],
+        "given twice",
+    );
+    bad(
+        vec![parts[0].clone(), parts[1].clone(), part(0, 3, "10")],
+        "the seed",
+    );
+    bad(vec![parts[0].clone(), part(1, 4, "9")], "the part count");
+    std::fs::write(
+        &scene,
+        TINY_SCENE.replace("intensity = 10", "intensity = 11"),
+    )
+    .unwrap();
+    let other = part(0, 3, "9");
+    bad(vec![parts[0].clone(), parts[1].clone(), other], "the scene");
+    std::fs::write(dir.path().join("junk.fcpart"), b"FCRPART1 and garbage").unwrap();
+    bad(
+        vec![dir.path().join("junk.fcpart").to_str().unwrap().into()],
+        "junk.fcpart",
+    );
+    assert!(!dir.path().join("bad.exr").exists());
+}
+
+#[test]
+fn table_parts_merge_into_the_same_table_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = r#"{type = "il", ni = 1.4, distribution = "beckmann", alpha = 0.5}"#;
+    let full = dir.path().join("full.fctab");
+    let o = facette(
+        &[
+            "tabulate",
+            "--material",
+            m,
+            "--step",
+            "10",
+            "--samples",
+            "256",
+            "-o",
+            full.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut parts = Vec::new();
+    for k in 0..4 {
+        let p = dir.path().join(format!("t{k}.fctpart"));
+        let o = facette(
+            &[
+                "tabulate",
+                "--material",
+                m,
+                "--step",
+                "10",
+                "--samples",
+                "256",
+                "--part",
+                &format!("{k}/4"),
+                "-o",
+                p.to_str().unwrap(),
+            ],
+            None,
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        parts.push(p.to_str().unwrap().to_string());
+    }
+    let merged = dir.path().join("merged.fctab");
+    let mut args = vec!["merge"];
+    args.extend(parts.iter().map(|p| p.as_str()));
+    args.extend(["-o", merged.to_str().unwrap()]);
+    let o = facette(&args, None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(&full).unwrap()
+    );
+    let o = facette(
+        &[
+            "merge",
+            &parts[0],
+            &parts[1],
+            "-o",
+            merged.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        stderr(&o).contains("missing part(s) 2, 3 of 4"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -156,6 +156,20 @@ impl Film {
     }
 }
 
+/// Bit-for-bit equality (sums compared by their bits): merged distributed renders are
+/// checked against in-process ones with it.
+impl PartialEq for Film {
+    fn eq(&self, o: &Film) -> bool {
+        let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        self.width == o.width
+            && self.height == o.height
+            && self.counts == o.counts
+            && self.discarded == o.discarded
+            && bits(&self.sums) == bits(&o.sums)
+            && bits(&self.sq_sums) == bits(&o.sq_sums)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

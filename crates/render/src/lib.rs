@@ -11,6 +11,7 @@
 //! - [`camera`], [`film`], [`lights`], [`materials`]: what a scene is made of.
 //! - [`integrator`]: the path tracer (NEE + MIS, Russian roulette).
 //! - [`render`]: tiles in parallel, passes, interruption, determinism.
+//! - [`partial_film`]: parts of a render for distributed runs, saved exactly and merged.
 
 // `!(x > 0.0)` is the NaN-rejecting test used throughout (a NaN must fail every check).
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -22,5 +23,6 @@ pub mod image;
 pub mod integrator;
 pub mod lights;
 pub mod materials;
+pub mod partial_film;
 pub mod render;
 pub mod scene;

@@ -78,106 +78,20 @@ impl BodyTable {
         samples: usize,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> ParamResult<BodyTable> {
-        if lobe.ndf.is_anisotropic() {
-            return Err(ParamError::Invalid(
-                "tables store (θ_i, θ_o, φ_o − φ_i) and need an isotropic distribution; \
-                 anisotropic IL uses evaluation = \"stochastic\" or \"quadrature\""
-                    .into(),
-            ));
-        }
-        let intervals = (90.0 / step_deg).round();
-        if !(step_deg > 0.0) || (intervals * step_deg - 90.0).abs() > 1e-9 || intervals < 1.0 {
-            return Err(ParamError::Invalid(format!(
-                "step = {step_deg}°: the grid step must divide 90° (e.g. 1, 2, 2.5, 5, 10)"
-            )));
-        }
-        if samples < 8 {
-            return Err(ParamError::OutOfRange {
-                name: "samples".into(),
-                value: samples as f64,
-                expected: "samples >= 8".into(),
-            });
-        }
-        let integral = MicrofacetIntegral::new(lobe.ndf.clone(), lobe.masking)?;
-        let n_theta = intervals as usize + 1;
-        let n_phi = 2 * intervals as usize + 1;
-        // The shared microfacet set: 8 rotations of a Hammersley set, with D cos / pdf.
-        const ROT: usize = 8;
-        let per = (samples / ROT).max(1) as u32;
-        let mut rng = Pcg32::new(mix_seed(0x7ab1e, samples as u64), 3);
-        let normals: Vec<Vec<(Vec3, f64)>> = (0..ROT)
-            .map(|_| {
-                let shift = rng.next_2d();
-                (0..per)
-                    .map(|k| {
-                        let m = integral.ndf.sample_normal(hammersley(k, per, shift));
-                        let p = integral.ndf.pdf_normal(m);
-                        let w = if p > 0.0 { integral.ndf.d(m) / p } else { 0.0 };
-                        (m, w)
-                    })
-                    .collect()
-            })
-            .collect();
-        let step = step_deg.to_radians();
-        let dir = |t: usize, p: usize| {
-            // Grazing nodes are evaluated just above the horizon, where the integral is
-            // continuous.
-            let th = (t as f64 * step).min(0.5 * PI - 1e-6);
-            spherical_direction(th, p as f64 * step)
-        };
-        let total_rows = n_theta;
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        // Row θ_i: entries (θ_o ≥ θ_i, φ) → (value, stderr).
-        let rows: Vec<Vec<(usize, usize, f64, f64)>> = (0..n_theta)
-            .into_par_iter()
-            .map(|ti| {
-                let i = dir(ti, 0);
-                let mut out = Vec::with_capacity((n_theta - ti) * n_phi);
-                // T(i·m) per normal, computed once for the row.
-                let ti_vals: Vec<Vec<f64>> = normals
-                    .iter()
-                    .map(|g| {
-                        g.iter()
-                            .map(|(m, _)| 1.0 - fresnel_dielectric(i.dot(*m).abs(), ni))
-                            .collect()
-                    })
-                    .collect();
-                for to in ti..n_theta {
-                    for ph in 0..n_phi {
-                        let o = dir(to, ph);
-                        let mut means = [0.0; ROT];
-                        for (r, group) in normals.iter().enumerate() {
-                            let mut s = 0.0;
-                            for (k, &(m, w)) in group.iter().enumerate() {
-                                let im = i.dot(m);
-                                let om = o.dot(m);
-                                if im <= 0.0 || om <= 0.0 || w == 0.0 {
-                                    continue;
-                                }
-                                let g = integral.masking.g(&integral.ndf, i, o, m);
-                                if g == 0.0 {
-                                    continue;
-                                }
-                                let t_o = 1.0 - fresnel_dielectric(om, ni);
-                                s += ti_vals[r][k] * t_o * w * g * im * om;
-                            }
-                            means[r] = s / (per as f64 * i.z * o.z);
-                        }
-                        let mean = means.iter().sum::<f64>() / ROT as f64;
-                        let var = means.iter().map(|x| (x - mean).powi(2)).sum::<f64>()
-                            / (ROT as f64 - 1.0);
-                        out.push((to, ph, mean, (var / ROT as f64).sqrt()));
-                    }
-                }
-                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(d, total_rows);
-                out
-            })
-            .collect();
+        let (grid, rows) = compute_rows(lobe, ni, step_deg, samples, &|_| true, progress)?;
+        Ok(BodyTable::assemble(grid, rows))
+    }
+
+    /// The table from its grid and all its θ_i rows in order (each entry computed
+    /// independently, so rows from separate parts assemble into exactly the table that
+    /// [`BodyTable::build`] makes).
+    pub(crate) fn assemble(grid: TableGrid, rows: Vec<TableRow>) -> BodyTable {
+        let (n_theta, n_phi) = (grid.n_theta, grid.n_phi);
         let mut data = vec![0.0; n_theta * n_theta * n_phi];
         let (mut max_se, mut sum_se, mut count) = (0.0f64, 0.0, 0usize);
-        for (ti, row) in rows.into_iter().enumerate() {
-            for (to, ph, v, se) in row {
+        for row in rows {
+            let ti = row.theta_i;
+            for (to, ph, v, se) in row.entries {
                 data[(ti * n_theta + to) * n_phi + ph] = v;
                 data[(to * n_theta + ti) * n_phi + ph] = v; // reciprocity
                                                             // Relative standard error, over the entries below the grazing row (where the
@@ -191,18 +105,18 @@ impl BodyTable {
                 }
             }
         }
-        Ok(BodyTable {
-            ni,
-            distribution: lobe.ndf.describe(),
-            masking: lobe.masking.name().to_string(),
-            step_deg,
+        BodyTable {
+            ni: grid.ni,
+            distribution: grid.distribution,
+            masking: grid.masking,
+            step_deg: grid.step_deg,
             n_theta,
             n_phi,
-            samples: per as usize * ROT,
+            samples: grid.samples,
             max_stderr: max_se,
             mean_stderr: sum_se / count.max(1) as f64,
             data,
-        })
+        }
     }
 
     /// Trilinear lookup for an upper-hemisphere pair.
@@ -390,30 +304,180 @@ impl BodyTable {
 
     /// Writes the table atomically (temporary file in the same directory, then rename).
     pub fn save(&self, path: &std::path::Path) -> Result<(), TableError> {
-        let p = path.display().to_string();
-        let io = |e: std::io::Error| TableError::Io {
-            path: p.clone(),
+        write_atomically(path, &self.to_bytes()).map_err(|e| TableError::Io {
+            path: path.display().to_string(),
             source: e,
-        };
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(std::path::Path::new("."));
-        let tmp = dir.join(format!(
-            ".{}.tmp-{}",
-            path.file_name().and_then(|n| n.to_str()).unwrap_or("table"),
-            std::process::id()
-        ));
-        let result = (|| {
-            use std::io::Write;
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(&self.to_bytes())?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        result.map_err(io)
+        })
     }
+}
+
+/// Writes `bytes` to a temporary file next to `path`, syncs it and renames it over `path`:
+/// a reader never sees a half-written file and a failure leaves the old file in place.
+pub(crate) fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let tmp = dir.join(format!(
+        ".{}.tmp-{}",
+        path.file_name().and_then(|n| n.to_str()).unwrap_or("table"),
+        std::process::id()
+    ));
+    let result = (|| {
+        use std::io::Write;
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// The grid and provenance of a table (everything but its values).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct TableGrid {
+    pub ni: f64,
+    pub distribution: String,
+    pub masking: String,
+    pub step_deg: f64,
+    pub n_theta: usize,
+    pub n_phi: usize,
+    /// Microfacets per entry actually used.
+    pub samples: usize,
+}
+
+/// One θ_i row: entries (θ_o index ≥ θ_i index, φ index, value, standard error).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct TableRow {
+    pub theta_i: usize,
+    pub entries: Vec<(usize, usize, f64, f64)>,
+}
+
+/// Computes the rows θ_i for which `keep(θ_i index)` holds [TSBRM §4.3: the body integral
+/// of IL18 eq. 13 without its K_d prefactor, on the (θ_i, θ_o, Δφ) grid]. Each entry uses
+/// the same shared microfacet set, so any subset of rows is computed exactly as in the
+/// full table.
+pub(crate) fn compute_rows(
+    lobe: &SpecularLobe,
+    ni: f64,
+    step_deg: f64,
+    samples: usize,
+    keep: &(dyn Fn(usize) -> bool + Sync),
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> ParamResult<(TableGrid, Vec<TableRow>)> {
+    if lobe.ndf.is_anisotropic() {
+        return Err(ParamError::Invalid(
+            "tables store (θ_i, θ_o, φ_o − φ_i) and need an isotropic distribution; \
+             anisotropic IL uses evaluation = \"stochastic\" or \"quadrature\""
+                .into(),
+        ));
+    }
+    let intervals = (90.0 / step_deg).round();
+    if !(step_deg > 0.0) || (intervals * step_deg - 90.0).abs() > 1e-9 || intervals < 1.0 {
+        return Err(ParamError::Invalid(format!(
+            "step = {step_deg}°: the grid step must divide 90° (e.g. 1, 2, 2.5, 5, 10)"
+        )));
+    }
+    if samples < 8 {
+        return Err(ParamError::OutOfRange {
+            name: "samples".into(),
+            value: samples as f64,
+            expected: "samples >= 8".into(),
+        });
+    }
+    let integral = MicrofacetIntegral::new(lobe.ndf.clone(), lobe.masking)?;
+    let n_theta = intervals as usize + 1;
+    let n_phi = 2 * intervals as usize + 1;
+    // The shared microfacet set: 8 rotations of a Hammersley set, with D cos / pdf.
+    const ROT: usize = 8;
+    let per = (samples / ROT).max(1) as u32;
+    let mut rng = Pcg32::new(mix_seed(0x7ab1e, samples as u64), 3);
+    let normals: Vec<Vec<(Vec3, f64)>> = (0..ROT)
+        .map(|_| {
+            let shift = rng.next_2d();
+            (0..per)
+                .map(|k| {
+                    let m = integral.ndf.sample_normal(hammersley(k, per, shift));
+                    let p = integral.ndf.pdf_normal(m);
+                    let w = if p > 0.0 { integral.ndf.d(m) / p } else { 0.0 };
+                    (m, w)
+                })
+                .collect()
+        })
+        .collect();
+    let step = step_deg.to_radians();
+    let dir = |t: usize, p: usize| {
+        // Grazing nodes are evaluated just above the horizon, where the integral is
+        // continuous.
+        let th = (t as f64 * step).min(0.5 * PI - 1e-6);
+        spherical_direction(th, p as f64 * step)
+    };
+    let wanted: Vec<usize> = (0..n_theta).filter(|&t| keep(t)).collect();
+    let total_rows = wanted.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    // Row θ_i: entries (θ_o ≥ θ_i, φ) → (value, stderr).
+    let rows: Vec<TableRow> = wanted
+        .into_par_iter()
+        .map(|ti| {
+            let i = dir(ti, 0);
+            let mut out = Vec::with_capacity((n_theta - ti) * n_phi);
+            // T(i·m) per normal, computed once for the row.
+            let ti_vals: Vec<Vec<f64>> = normals
+                .iter()
+                .map(|g| {
+                    g.iter()
+                        .map(|(m, _)| 1.0 - fresnel_dielectric(i.dot(*m).abs(), ni))
+                        .collect()
+                })
+                .collect();
+            for to in ti..n_theta {
+                for ph in 0..n_phi {
+                    let o = dir(to, ph);
+                    let mut means = [0.0; ROT];
+                    for (r, group) in normals.iter().enumerate() {
+                        let mut s = 0.0;
+                        for (k, &(m, w)) in group.iter().enumerate() {
+                            let im = i.dot(m);
+                            let om = o.dot(m);
+                            if im <= 0.0 || om <= 0.0 || w == 0.0 {
+                                continue;
+                            }
+                            let g = integral.masking.g(&integral.ndf, i, o, m);
+                            if g == 0.0 {
+                                continue;
+                            }
+                            let t_o = 1.0 - fresnel_dielectric(om, ni);
+                            s += ti_vals[r][k] * t_o * w * g * im * om;
+                        }
+                        means[r] = s / (per as f64 * i.z * o.z);
+                    }
+                    let mean = means.iter().sum::<f64>() / ROT as f64;
+                    let var =
+                        means.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (ROT as f64 - 1.0);
+                    out.push((to, ph, mean, (var / ROT as f64).sqrt()));
+                }
+            }
+            let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(d, total_rows);
+            TableRow {
+                theta_i: ti,
+                entries: out,
+            }
+        })
+        .collect();
+    Ok((
+        TableGrid {
+            ni,
+            distribution: lobe.ndf.describe(),
+            masking: lobe.masking.name().to_string(),
+            step_deg,
+            n_theta,
+            n_phi,
+            samples: per as usize * ROT,
+        },
+        rows,
+    ))
 }

@@ -4,6 +4,7 @@
 pub mod il_approx;
 pub mod il_approx_coefficients;
 pub mod il_table;
+pub mod il_table_part;
 pub mod interfaced_lambertian;
 pub mod kelemen;
 pub mod lambert;
