@@ -1,0 +1,31 @@
+from typing import Optional, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from . import MaterialSpec, Path, Scene
+
+def render(
+    scene: Scene,
+    parts: int,
+    output: Optional[Path] = ...,
+    spp: Optional[int] = ...,
+    seed: int = ...,
+    address: Optional[str] = ...,
+    num_cpus: Optional[int] = ...,
+    threads_per_task: int = ...,
+    max_retries: int = ...,
+    progress: bool = ...,
+) -> npt.NDArray[np.float32]: ...
+def tabulate(
+    material: MaterialSpec,
+    parts: int,
+    output: Optional[Path] = ...,
+    step: float = ...,
+    samples: int = ...,
+    address: Optional[str] = ...,
+    num_cpus: Optional[int] = ...,
+    max_retries: int = ...,
+    progress: bool = ...,
+) -> bytes: ...
+def main(argv: Optional[Sequence[str]] = ...) -> int: ...

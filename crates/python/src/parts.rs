@@ -1,0 +1,195 @@
+//! Work that splits exactly, for distributed runs (`facette.distributed`): parts of a
+//! render and of an IL table as bytes (the `.fcpart` / `.fctpart` formats of
+//! docs/file-formats.md), and their merges.
+
+use crate::errors::{os_error, value_error};
+use crate::render::{film_array, options, scene_from};
+use crate::toml_value::table_from_py;
+use facette_bsdf::models::il_table::BodyTable;
+use facette_bsdf::models::il_table_part::{merge_table_parts as merge_tables, TablePart};
+use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::InterfacedLambertian;
+use facette_bsdf::spec::microfacet::{parse_distribution, parse_masking, parse_sampling};
+use facette_bsdf::spec::Params;
+use facette_render::partial_film::{merge_parts, PartialFilm};
+use numpy::{IntoPyArray, PyArray3};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// Renders part `part` of `parts` of a scene's samples; returns the `.fcpart` bytes.
+#[pyfunction]
+#[pyo3(signature = (scene, part, parts, spp = None, seed = 0, threads = None))]
+pub fn render_part<'py>(
+    py: Python<'py>,
+    scene: &str,
+    part: u32,
+    parts: u32,
+    spp: Option<usize>,
+    seed: u64,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let opts = options(spp, seed, threads)?;
+    let scene = scene.to_string();
+    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
+        let s = scene_from(&scene)?;
+        let (p, _) = facette_render::partial_film::render_part(
+            &s,
+            &opts,
+            part,
+            parts,
+            &AtomicBool::new(false),
+            &|_, _| {},
+        )
+        .map_err(value_error)?;
+        Ok(p.to_bytes())
+    })?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// The N parts rendered in this process and merged: the reference a distributed render
+/// reproduces bit for bit. Returns (H, W, 3) float32 times 2^(scene exposure).
+#[pyfunction]
+#[pyo3(signature = (scene, parts, spp = None, seed = 0, threads = None))]
+pub fn render_in_parts<'py>(
+    py: Python<'py>,
+    scene: &str,
+    parts: u32,
+    spp: Option<usize>,
+    seed: u64,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let opts = options(spp, seed, threads)?;
+    let scene = scene.to_string();
+    let a = py.detach(move || -> PyResult<_> {
+        let s = scene_from(&scene)?;
+        let film =
+            facette_render::partial_film::render_in_parts(&s, &opts, parts).map_err(value_error)?;
+        Ok(film_array(&film, s.film.exposure))
+    })?;
+    Ok(a.into_pyarray(py))
+}
+
+/// Merges render parts (bytes of `.fcpart` files, any order); returns (H, W, 3) float32
+/// times 2^exposure (the parts' scene exposure unless given).
+#[pyfunction]
+#[pyo3(signature = (parts, exposure = None))]
+pub fn merge_render_parts<'py>(
+    py: Python<'py>,
+    parts: Vec<Vec<u8>>,
+    exposure: Option<f64>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let a = py.detach(move || -> PyResult<_> {
+        let films: Vec<PartialFilm> = parts
+            .iter()
+            .enumerate()
+            .map(|(k, b)| PartialFilm::from_bytes(b, Path::new(&format!("part #{k}"))))
+            .collect::<Result<_, _>>()
+            .map_err(value_error)?;
+        let film = merge_parts(&films).map_err(value_error)?;
+        let e = exposure.unwrap_or(films[0].exposure);
+        Ok(film_array(&film, e))
+    })?;
+    Ok(a.into_pyarray(py))
+}
+
+/// The microfacet lobe and n_i of a rough IL material (tables need one).
+fn il_lobe(
+    material: &Bound<'_, PyAny>,
+) -> PyResult<(facette_bsdf::microfacet::specular_lobe::SpecularLobe, f64)> {
+    let table = table_from_py(material)?;
+    let ty = table.get("type").and_then(|v| v.as_str()).unwrap_or("");
+    if ty != "il" && ty != "interfaced-lambertian" {
+        return Err(value_error(format!(
+            "tabulate needs an interfaced-Lambertian material (type = \"il\"), got type `{ty}`"
+        )));
+    }
+    facette_bsdf::spec::build_material(&table).map_err(value_error)?;
+    let p = Params::new(&table, "material \"il\"");
+    let ni = p.f64_or("ni", 1.5).map_err(value_error)?;
+    let ndf = parse_distribution(&p, true)
+        .map_err(value_error)?
+        .ok_or_else(|| value_error("the material is flat (alpha = 0): its body term needs no table"))?;
+    let masking = parse_masking(&p, Some(&ndf)).map_err(value_error)?;
+    let sampling = parse_sampling(&p).map_err(value_error)?;
+    let lobe = facette_bsdf::microfacet::specular_lobe::SpecularLobe::new(ndf, masking, sampling)
+        .map_err(value_error)?;
+    // Validates the combination as the material would.
+    InterfacedLambertian::new(
+        facette_bsdf::Spectrum::splat(0.5),
+        ni,
+        Some(lobe.clone()),
+        BodyEvaluation::Stochastic,
+        Scattering::Single,
+    )
+    .map_err(value_error)?;
+    Ok((lobe, ni))
+}
+
+/// Tabulates the body term of an IL material (`facette tabulate`); returns the `.fctab`
+/// bytes and writes them to `output` when given.
+#[pyfunction]
+#[pyo3(signature = (material, step = 5.0, samples = 10_000, output = None))]
+pub fn tabulate<'py>(
+    py: Python<'py>,
+    material: &Bound<'py, PyAny>,
+    step: f64,
+    samples: usize,
+    output: Option<std::path::PathBuf>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let (lobe, ni) = il_lobe(material)?;
+    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
+        let t = BodyTable::build(&lobe, ni, step, samples, &|_, _| {}).map_err(value_error)?;
+        if let Some(o) = &output {
+            t.save(o).map_err(os_error)?;
+        }
+        Ok(t.to_bytes())
+    })?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// Part `part` of `parts` of a table (`facette tabulate --part`); returns `.fctpart` bytes.
+#[pyfunction]
+#[pyo3(signature = (material, part, parts, step = 5.0, samples = 10_000))]
+pub fn tabulate_part<'py>(
+    py: Python<'py>,
+    material: &Bound<'py, PyAny>,
+    part: u32,
+    parts: u32,
+    step: f64,
+    samples: usize,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let (lobe, ni) = il_lobe(material)?;
+    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
+        let p = TablePart::build(&lobe, ni, step, samples, part, parts, &|_, _| {})
+            .map_err(value_error)?;
+        Ok(p.to_bytes())
+    })?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// Merges table parts (bytes, any order) into the `.fctab` bytes (written to `output` when
+/// given) — byte for byte what `tabulate` makes.
+#[pyfunction]
+#[pyo3(signature = (parts, output = None))]
+pub fn merge_table_parts<'py>(
+    py: Python<'py>,
+    parts: Vec<Vec<u8>>,
+    output: Option<std::path::PathBuf>,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
+        let ps: Vec<TablePart> = parts
+            .iter()
+            .enumerate()
+            .map(|(k, b)| TablePart::from_bytes(b, &format!("part #{k}")))
+            .collect::<Result<_, _>>()
+            .map_err(value_error)?;
+        let t = merge_tables(&ps).map_err(|e| value_error(format!("cannot merge: {e}")))?;
+        if let Some(o) = &output {
+            t.save(o).map_err(os_error)?;
+        }
+        Ok(t.to_bytes())
+    })?;
+    Ok(PyBytes::new(py, &bytes))
+}
