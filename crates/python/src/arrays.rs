@@ -18,7 +18,7 @@ pub fn directions(a: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<Vec<Vec
     for (k, row) in v.rows().into_iter().enumerate() {
         let d = Vec3::new(row[0], row[1], row[2]);
         let len = d.length();
-        if !d.is_finite() || !(len > 0.0) {
+        if !d.is_finite() || len == 0.0 {
             return Err(value_error(format!(
                 "`{name}`[{k}] = ({}, {}, {}) is not a finite non-zero vector",
                 row[0], row[1], row[2]

@@ -138,9 +138,8 @@ impl Material {
             )));
         }
         let bsdf = self.bsdf.clone();
-        let out = py.detach(move || {
-            Array1::from_iter((0..wi.len()).map(|k| bsdf.pdf(wo[k], wi[k], &ctx)))
-        });
+        let out = py
+            .detach(move || Array1::from_iter((0..wi.len()).map(|k| bsdf.pdf(wo[k], wi[k], &ctx))));
         Ok(out.into_pyarray(py))
     }
 
@@ -246,13 +245,7 @@ impl Material {
                 .iter()
                 .map(|t| {
                     let wi = spherical_direction(t.to_radians(), 0.0);
-                    directional_albedo(
-                        bsdf.as_ref(),
-                        wi,
-                        &BsdfContext::IMPORTANCE,
-                        samples,
-                        seed,
-                    )
+                    directional_albedo(bsdf.as_ref(), wi, &BsdfContext::IMPORTANCE, samples, seed)
                 })
                 .collect::<Vec<_>>()
         });

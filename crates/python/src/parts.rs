@@ -110,7 +110,9 @@ fn il_lobe(
     let ni = p.f64_or("ni", 1.5).map_err(value_error)?;
     let ndf = parse_distribution(&p, true)
         .map_err(value_error)?
-        .ok_or_else(|| value_error("the material is flat (alpha = 0): its body term needs no table"))?;
+        .ok_or_else(|| {
+            value_error("the material is flat (alpha = 0): its body term needs no table")
+        })?;
     let masking = parse_masking(&p, Some(&ndf)).map_err(value_error)?;
     let sampling = parse_sampling(&p).map_err(value_error)?;
     let lobe = facette_bsdf::microfacet::specular_lobe::SpecularLobe::new(ndf, masking, sampling)

@@ -17,7 +17,9 @@ pub fn scene_from(scene: &str) -> PyResult<Scene> {
     }
     let path = PathBuf::from(scene);
     if !path.is_file() {
-        return Err(os_error(format!("{scene}: cannot read the scene file: no such file")));
+        return Err(os_error(format!(
+            "{scene}: cannot read the scene file: no such file"
+        )));
     }
     load_scene(&path).map_err(value_error)
 }
@@ -87,9 +89,14 @@ pub fn write_image(path: PathBuf, image: PyReadonlyArray3<'_, f32>, exposure: f6
     let v = image.as_array();
     let (h, w, c) = v.dim();
     if c != 3 || h == 0 || w == 0 {
-        return Err(value_error(format!("`image` must have shape (H, W, 3), got {:?}", v.shape())));
+        return Err(value_error(format!(
+            "`image` must have shape (H, W, 3), got {:?}",
+            v.shape()
+        )));
     }
-    let data: Vec<[f32; 3]> = (0..h * w).map(|k| [0, 1, 2].map(|ch| v[[k / w, k % w, ch]])).collect();
+    let data: Vec<[f32; 3]> = (0..h * w)
+        .map(|k| [0, 1, 2].map(|ch| v[[k / w, k % w, ch]]))
+        .collect();
     let img = facette_render::image::RgbImage::new(w, h, data).map_err(value_error)?;
     facette_render::image::write_image(&path, &img, exposure).map_err(|e| match e {
         facette_render::image::ImageError::Write { .. } => os_error(e),
@@ -101,9 +108,17 @@ pub fn write_image(path: PathBuf, image: PyReadonlyArray3<'_, f32>, exposure: f6
 /// (8/16-bit files are decoded from sRGB unless `linear`).
 #[pyfunction]
 #[pyo3(signature = (path, linear = false))]
-pub fn read_image<'py>(py: Python<'py>, path: PathBuf, linear: bool) -> PyResult<Bound<'py, PyArray3<f32>>> {
+pub fn read_image<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    linear: bool,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
     use facette_render::image::{ColorEncoding, ImageError};
-    let enc = if linear { ColorEncoding::Linear } else { ColorEncoding::Srgb };
+    let enc = if linear {
+        ColorEncoding::Linear
+    } else {
+        ColorEncoding::Srgb
+    };
     let img = facette_render::image::read_image(&path, enc).map_err(|e| match e {
         ImageError::Read { .. } => os_error(e),
         other => value_error(other),
