@@ -150,6 +150,65 @@ fn lambertian_plane_under_a_point_light_matches_kd_over_pi_i_cos_over_r2() {
 }
 
 #[test]
+fn spot_light_is_a_point_light_inside_its_beam_and_dark_outside_its_cutoff() {
+    let (kd, intensity) = (0.5, 8.0);
+    let pos = glam::DVec3::new(0.0, 2.0, 0.0);
+    let (beam, cutoff) = (20.0f64, 30.0f64);
+    let s = plane_scene(
+        &format!(
+            "[[lights]]\ntype = \"spot\"\nposition = [0, 2, 0]\ndirection = [0, -1, 0]\nintensity = {intensity}\nbeam_width = {beam}\ncutoff_angle = {cutoff}"
+        ),
+        kd,
+        48,
+    );
+    let film = run(&s, 4, 1, Strategy::Mis, None);
+    let img = film.image();
+    let (mut inside, mut outside, mut between) = (0, 0, 0);
+    for y in 0..48 {
+        for x in 0..48 {
+            // Pixel corners decide whether the whole footprint is on one side of an edge.
+            let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(dx, dy)| {
+                let (ray, _) =
+                    s.camera
+                        .generate_ray(x as f64 + dx, y as f64 + dy, glam::DVec2::ZERO);
+                let p = ray.origin + ray.dir * (-ray.origin.y / ray.dir.y);
+                (pos - p).normalize().y.acos().to_degrees()
+            });
+            let (lo, hi) = corners
+                .iter()
+                .fold((f64::MAX, 0.0f64), |(l, h), a| (l.min(*a), h.max(*a)));
+            let got = img.get(x, y)[0] as f64;
+            if hi < beam {
+                let p = plane_point(&s, x, y);
+                let d = pos - p;
+                let expected = kd / PI * intensity * (d.y / d.length()) / d.length_squared();
+                assert!(
+                    (got / expected - 1.0).abs() < 0.02,
+                    "({x}, {y}): {got} vs {expected}"
+                );
+                inside += 1;
+            } else if lo > cutoff {
+                assert_eq!(got, 0.0, "({x}, {y}) is outside the cutoff");
+                outside += 1;
+            } else if lo > beam && hi < cutoff {
+                between += 1;
+                let p = plane_point(&s, x, y);
+                let d = pos - p;
+                let full = kd / PI * intensity * (d.y / d.length()) / d.length_squared();
+                assert!(
+                    got > 0.0 && got < full,
+                    "({x}, {y}): falloff {got} vs full {full}"
+                );
+            }
+        }
+    }
+    assert!(
+        inside > 50 && outside > 50 && between > 20,
+        "{inside} {outside} {between}"
+    );
+}
+
+#[test]
 fn lambertian_plane_under_a_directional_light_is_kd_over_pi_e_cos() {
     let (kd, e) = (0.8, 3.0);
     let dir = glam::DVec3::new(1.0, -2.0, 0.5).normalize();
