@@ -31,10 +31,11 @@
 //! Flat IL is `evaluation`-independent (closed form). IL with n_i = 1 is the exact
 //! Oren–Nayar model when the distribution is Gaussian with V-cavity masking.
 
+use super::cosine_lobe::sample_cosine_same_side;
 use super::il_approx::IlApprox;
 use super::il_table::BodyTable;
 use super::microfacet_integral::MicrofacetIntegral;
-use super::oren_nayar::{sample_cosine_same_side, QUADRATURE_SEED};
+use super::oren_nayar::QUADRATURE_SEED;
 use super::vcavity::{self, IlFacet, Orders};
 use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};

@@ -4,12 +4,12 @@
 //! |---|---|---|---|
 //! | `reflectance` | albedo R (number or RGB) | [0, 1] | 0.5 |
 
-use super::{flip, to_upper_pair};
+use super::cosine_lobe::{cosine_same_side_pdf, sample_cosine_same_side};
+use super::to_upper_pair;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::error::ParamResult;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use crate::math::{Vec3, INV_PI};
 use crate::spec::params::check_spectrum;
 
@@ -39,30 +39,19 @@ impl Bsdf for Lambert {
     }
 
     fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let mut wi = square_to_cosine_hemisphere(rng.next_2d());
-        if wi.z <= 0.0 {
-            return None;
-        }
-        if wo.z < 0.0 {
-            wi = flip(wi);
-        }
+        // f·cos/pdf = reflectance exactly: no evaluation needed.
+        let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
         Some(BsdfSample {
             wi,
             weight: self.reflectance,
-            pdf: cosine_hemisphere_pdf(Vec3::new(wi.x, wi.y, wi.z.abs())),
+            pdf,
             lobe: LobeFlags::DIFFUSE_REFLECTION,
             eta: 1.0,
         })
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        match to_upper_pair(wo, wi) {
-            Some((_, wi)) => cosine_hemisphere_pdf(wi),
-            None => 0.0,
-        }
+        cosine_same_side_pdf(wo, wi)
     }
 
     fn describe(&self) -> String {

@@ -18,13 +18,13 @@
 //! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (N microfacets, deterministic) | — | `quadrature` |
 //! | `samples` | exact, quadrature: microfacets per evaluation | ≥ 8 | 256 |
 
+use super::cosine_lobe::{cosine_same_side_pdf, sample_diffuse_reflection};
 use super::microfacet_integral::MicrofacetIntegral;
-use super::{flip, to_upper_pair};
+use super::to_upper_pair;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{check_range, Bounds, ParamError, ParamResult};
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
-use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
 use crate::microfacet::{Gaussian, Masking, Ndf};
 use crate::spec::params::check_spectrum;
@@ -41,20 +41,6 @@ pub enum IntegralEvaluation {
 
 impl IntegralEvaluation {
     pub const NAMES: &'static [&'static str] = &["stochastic", "quadrature"];
-}
-
-/// Cosine-weighted sampling shared by the diffuse-type models: returns (wi, pdf) on the side
-/// of `wo`.
-pub(crate) fn sample_cosine_same_side(wo: Vec3, rng: &mut dyn RandomSource) -> Option<(Vec3, f64)> {
-    if wo.z == 0.0 {
-        return None;
-    }
-    let wi = square_to_cosine_hemisphere(rng.next_2d());
-    if wi.z <= 0.0 {
-        return None;
-    }
-    let pdf = cosine_hemisphere_pdf(wi);
-    Some((if wo.z < 0.0 { flip(wi) } else { wi }, pdf))
 }
 
 #[derive(Clone, Debug)]
@@ -161,22 +147,11 @@ impl Bsdf for OrenNayarExact {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
-        let f = self.eval(wo, wi, ctx, rng);
-        Some(BsdfSample {
-            wi,
-            weight: f * (wi.z.abs() / pdf),
-            pdf,
-            lobe: LobeFlags::DIFFUSE_REFLECTION,
-            eta: 1.0,
-        })
+        sample_diffuse_reflection(self, wo, ctx, rng)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        match to_upper_pair(wo, wi) {
-            Some((_, wi)) => cosine_hemisphere_pdf(wi),
-            None => 0.0,
-        }
+        cosine_same_side_pdf(wo, wi)
     }
 
     fn describe(&self) -> String {
@@ -308,22 +283,11 @@ impl Bsdf for OrenNayarQualitative {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
-        let f = self.eval(wo, wi, ctx, rng);
-        Some(BsdfSample {
-            wi,
-            weight: f * (wi.z.abs() / pdf),
-            pdf,
-            lobe: LobeFlags::DIFFUSE_REFLECTION,
-            eta: 1.0,
-        })
+        sample_diffuse_reflection(self, wo, ctx, rng)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        match to_upper_pair(wo, wi) {
-            Some((_, wi)) => cosine_hemisphere_pdf(wi),
-            None => 0.0,
-        }
+        cosine_same_side_pdf(wo, wi)
     }
 
     fn describe(&self) -> String {
