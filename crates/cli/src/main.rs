@@ -4,6 +4,7 @@
 mod cmd_albedo;
 mod cmd_eval;
 mod cmd_il_approx;
+mod cmd_plot;
 mod cmd_render;
 mod cmd_tabulate;
 mod cmd_validate;
@@ -41,6 +42,8 @@ enum Command {
     Tabulate(cmd_tabulate::TabulateArgs),
     /// Fit or measure the approximate interfaced-Lambertian body term (IL18 §4.2).
     IlApprox(cmd_il_approx::IlApproxArgs),
+    /// Plot a material: incidence-plane slices, polar lobes, hemisphere maps, albedo; or an IL body table against its quadrature.
+    Plot(cmd_plot::PlotArgs),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +55,7 @@ fn main() -> ExitCode {
         Command::Validate(a) => cmd_validate::run(a),
         Command::Tabulate(a) => cmd_tabulate::run(a),
         Command::IlApprox(a) => cmd_il_approx::run(a),
+        Command::Plot(a) => cmd_plot::run(a),
     };
     match result {
         Ok(code) => code,

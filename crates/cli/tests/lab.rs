@@ -1,0 +1,305 @@
+//! End-to-end tests of the lab commands: `plot`, `fit` and `reproduce`. Each checks the
+//! numbers a command prints or writes, not only that a file appeared.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn facette(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args(args)
+        .output()
+        .expect("facette runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn ok(o: &Output) {
+    assert!(
+        o.status.success(),
+        "stdout:\n{}\nstderr:\n{}",
+        stdout(o),
+        stderr(o)
+    );
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The (series, x, y) rows of a `--csv` file.
+fn csv_rows(p: &Path) -> Vec<(String, f64, f64)> {
+    std::fs::read_to_string(p)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (name, rest) = l.rsplit_once(',').unwrap();
+            let (name, x) = name.rsplit_once(',').unwrap();
+            (
+                name.trim_matches('"').to_string(),
+                x.parse().unwrap(),
+                rest.parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+fn is_png(p: &Path) -> bool {
+    std::fs::read(p)
+        .map(|b| b.len() > 1000 && &b[1..4] == b"PNG")
+        .unwrap_or(false)
+}
+
+const LAMBERT: &str = r#"{type = "lambert", reflectance = 0.5}"#;
+const CONDUCTOR: &str = r#"{type = "conductor", distribution = "ggx", alpha = 0.05}"#;
+
+#[test]
+fn plot_slice_of_two_materials_has_the_expected_shapes() {
+    let d = tmp();
+    let (svg, csv) = (d.path().join("s.svg"), d.path().join("s.csv"));
+    let o = facette(&[
+        "plot",
+        "slice",
+        "--material",
+        LAMBERT,
+        "--material",
+        CONDUCTOR,
+        "--label",
+        "matte",
+        "--label",
+        "metal",
+        "--theta-i",
+        "40",
+        "--log",
+        "--points",
+        "181",
+        "-o",
+        s(&svg),
+        "--csv",
+        s(&csv),
+    ]);
+    ok(&o);
+    let out = stdout(&o);
+    assert!(out.contains("matte: max 1.591549e-1"), "{out}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    for label in [
+        "matte",
+        "metal",
+        "f (1/sr)",
+        "θ_o (degrees",
+        "mirror direction",
+    ] {
+        assert!(text.contains(label), "the SVG lacks {label}");
+    }
+    let rows = csv_rows(&csv);
+    for (_, _, y) in rows.iter().filter(|r| r.0 == "matte") {
+        assert!((y - 0.5 / std::f64::consts::PI).abs() < 1e-8);
+    }
+    // The narrow GGX lobe peaks at the mirror direction θ_o = +θ_i (1° grid).
+    let peak = rows
+        .iter()
+        .filter(|r| r.0 == "metal")
+        .max_by(|a, b| a.2.total_cmp(&b.2))
+        .unwrap();
+    assert!((peak.1 - 40.0).abs() <= 1.0, "{peak:?}");
+}
+
+#[test]
+fn plot_polar_hemisphere_and_albedo() {
+    let d = tmp();
+    // Polar lobe of f·|cos θ_o| of a Lambertian surface: a circle of diameter ρ/π.
+    let (png, csv) = (d.path().join("p.png"), d.path().join("p.csv"));
+    let o = facette(&[
+        "plot",
+        "polar",
+        "--material",
+        LAMBERT,
+        "--quantity",
+        "fcos",
+        "--theta-i",
+        "30",
+        "-o",
+        s(&png),
+        "--csv",
+        s(&csv),
+    ]);
+    ok(&o);
+    assert!(is_png(&png));
+    let r = 0.5 / std::f64::consts::PI / 2.0;
+    let lobe: Vec<_> = csv_rows(&csv)
+        .into_iter()
+        .filter(|x| x.0 == "θ_i = 30°")
+        .collect();
+    assert_eq!(lobe.len(), 181);
+    for (_, x, z) in lobe {
+        assert!(((x * x + (z - r) * (z - r)).sqrt() - r).abs() < 1e-8);
+    }
+    // Hemisphere map of a Lambertian surface: one value everywhere.
+    let png = d.path().join("h.png");
+    let o = facette(&[
+        "plot",
+        "hemisphere",
+        "--material",
+        LAMBERT,
+        "--theta-i",
+        "45",
+        "--resolution",
+        "32",
+        "-o",
+        s(&png),
+    ]);
+    ok(&o);
+    assert!(
+        stdout(&o).contains("min 1.591549e-1, max 1.591549e-1"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(is_png(&png));
+    // Albedo: a smooth dielectric reflects Fresnel and transmits the rest.
+    let (svg, csv) = (d.path().join("a.svg"), d.path().join("a.csv"));
+    let o = facette(&[
+        "plot",
+        "albedo",
+        "--material",
+        r#"{type = "dielectric", alpha = 0, ior = 1.5}"#,
+        "--step",
+        "30",
+        "--samples",
+        "20000",
+        "-o",
+        s(&svg),
+        "--csv",
+        s(&csv),
+    ]);
+    ok(&o);
+    let rows = csv_rows(&csv);
+    let at = |name: &str, x: f64| rows.iter().find(|r| r.0 == name && r.1 == x).unwrap().2;
+    assert!((at("reflectance R", 0.0) - 0.04).abs() < 0.005, "{rows:?}");
+    assert!((at("R + T", 60.0) - 1.0).abs() < 1e-9);
+}
+
+#[test]
+fn plot_table_against_quadrature() {
+    let d = tmp();
+    let table = d.path().join("t.fctab");
+    let mat = r#"{type = "il", kd = 0.9, ni = 1.2, distribution = "gaussian", sigma = 0.3}"#;
+    let o = facette(&[
+        "tabulate",
+        "--material",
+        mat,
+        "--step",
+        "10",
+        "--samples",
+        "512",
+        "-o",
+        s(&table),
+    ]);
+    ok(&o);
+    let png = d.path().join("t.png");
+    let o = facette(&[
+        "plot",
+        "table",
+        "--material",
+        mat,
+        "--table",
+        s(&table),
+        "--theta-i",
+        "60",
+        "--samples",
+        "4096",
+        "--points",
+        "91",
+        "-o",
+        s(&png),
+    ]);
+    ok(&o);
+    let out = stdout(&o);
+    let num = |key: &str| -> f64 {
+        let i = out.find(key).unwrap_or_else(|| panic!("{key} in {out}")) + key.len();
+        out[i..]
+            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+            .find(|t| !t.is_empty())
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let (interp, nearest) = (
+        num("interpolated mean relative error "),
+        num("nearest entry mean "),
+    );
+    // A 10° grid with interpolation is within a few per cent (TSBRM §4.3); the nearest entry
+    // is clearly worse.
+    assert!(interp < 0.05 && nearest > interp, "{out}");
+    assert!(is_png(&png));
+    // A table built for another material is refused.
+    let o = facette(&[
+        "plot",
+        "table",
+        "--material",
+        r#"{type = "il", ni = 1.5, distribution = "gaussian", sigma = 0.3}"#,
+        "--table",
+        s(&table),
+        "-o",
+        s(&png),
+    ]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("the table was built for ni = 1.2"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn plot_errors_are_clear_and_write_nothing() {
+    let d = tmp();
+    let bad: PathBuf = d.path().join("x.jpg");
+    let o = facette(&["plot", "slice", "--material", LAMBERT, "-o", s(&bad)]);
+    assert!(!o.status.success() && stderr(&o).contains("use a .svg or .png extension"));
+    let out = d.path().join("x.svg");
+    let o = facette(&[
+        "plot",
+        "slice",
+        "--material",
+        LAMBERT,
+        "--quantity",
+        "g",
+        "-o",
+        s(&out),
+    ]);
+    assert!(
+        stderr(&o).contains("valid values: f, fcos, fcos-i"),
+        "{}",
+        stderr(&o)
+    );
+    let o = facette(&[
+        "plot",
+        "slice",
+        "--material",
+        LAMBERT,
+        "--theta-i",
+        "95",
+        "-o",
+        s(&out),
+    ]);
+    assert!(stderr(&o).contains("[0, 90)"), "{}", stderr(&o));
+    let o = facette(&[
+        "plot",
+        "slice",
+        "--material",
+        "{type = \"lambret\"}",
+        "-o",
+        s(&out),
+    ]);
+    assert!(stderr(&o).contains("lambert, oren-nayar"), "{}", stderr(&o));
+    assert!(!out.exists() && !bad.exists());
+}
