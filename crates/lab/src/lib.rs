@@ -7,4 +7,5 @@
 pub mod atomic_file;
 pub mod il_approx_fit;
 pub mod least_squares;
+pub mod merl;
 pub mod plot;
