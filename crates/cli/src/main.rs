@@ -3,6 +3,7 @@
 
 mod cmd_albedo;
 mod cmd_eval;
+mod cmd_fit;
 mod cmd_il_approx;
 mod cmd_plot;
 mod cmd_render;
@@ -44,6 +45,8 @@ enum Command {
     IlApprox(cmd_il_approx::IlApproxArgs),
     /// Plot a material: incidence-plane slices, polar lobes, hemisphere maps, albedo; or an IL body table against its quadrature.
     Plot(cmd_plot::PlotArgs),
+    /// Fit IL, plastic (Lambert + Cook–Torrance) or KSK01 to a measured MERL BRDF.
+    Fit(cmd_fit::FitArgs),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::Tabulate(a) => cmd_tabulate::run(a),
         Command::IlApprox(a) => cmd_il_approx::run(a),
         Command::Plot(a) => cmd_plot::run(a),
+        Command::Fit(a) => cmd_fit::run(a),
     };
     match result {
         Ok(code) => code,

@@ -303,3 +303,129 @@ fn plot_errors_are_clear_and_write_nothing() {
     assert!(stderr(&o).contains("lambert, oren-nayar"), "{}", stderr(&o));
     assert!(!out.exists() && !bad.exists());
 }
+
+mod fit {
+    use super::*;
+    use facette_bsdf::math::rng::{mix_seed, Pcg32};
+    use facette_bsdf::spec::{build_material, parse_inline_table};
+    use facette_bsdf::BsdfContext;
+    use facette_lab::merl::MerlBrdf;
+
+    /// Writes a synthetic MERL file of `material` (3 % of the bins when `sparse`).
+    fn synthetic(material: &str, sparse: bool, noise: f64, path: &Path) {
+        let b = build_material(&parse_inline_table(material).unwrap()).unwrap();
+        let mut m = MerlBrdf::from_fn(|k, i, o| {
+            (!sparse || mix_seed(3, k as u64) % 100 < 3)
+                .then(|| b.eval(o, i, &BsdfContext::RADIANCE, &mut Pcg32::new(1, 1)))
+        });
+        if noise > 0.0 {
+            m = m.with_multiplicative_noise(noise, 4);
+        }
+        m.save(path).unwrap();
+    }
+
+    fn value(out: &str, name: &str) -> f64 {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(&format!("{name} = ")))
+            .unwrap_or_else(|| panic!("no {name} in {out}"));
+        line[name.len() + 3..]
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    }
+
+    #[test]
+    fn fit_kelemen_from_the_cli_recovers_its_parameters() {
+        let d = tmp();
+        let file = d.path().join("k.binary");
+        synthetic(
+            r#"{type = "kelemen", alpha = 0.2, ior = 1.5, kd = [0.5, 0.3, 0.2]}"#,
+            false,
+            0.05,
+            &file,
+        );
+        let png = d.path().join("k.png");
+        let o = facette(&[
+            "fit",
+            s(&file),
+            "--model",
+            "kelemen",
+            "--samples",
+            "2000",
+            "-o",
+            s(&png),
+        ]);
+        ok(&o);
+        let out = stdout(&o);
+        for (name, expected) in [("kd_r", 0.5), ("kd_g", 0.3), ("alpha", 0.2), ("ior", 1.5)] {
+            let v = value(&out, name);
+            assert!((v / expected - 1.0).abs() < 0.03, "{name} = {v}\n{out}");
+        }
+        assert!(out.contains("material: {type = \"kelemen\""), "{out}");
+        assert!(is_png(&png));
+    }
+
+    #[test]
+    fn fit_il_with_the_approximate_body_and_plastic() {
+        let d = tmp();
+        let file = d.path().join("il.binary");
+        synthetic(
+            r#"{type = "il", kd = [0.34, 0.34, 0.34], ni = 1.12, alpha = 0.092, evaluation = "quadrature", samples = 512}"#,
+            true,
+            0.0,
+            &file,
+        );
+        let o = facette(&[
+            "fit",
+            s(&file),
+            "--il-evaluation",
+            "approx",
+            "--samples",
+            "3000",
+        ]);
+        ok(&o);
+        let out = stdout(&o);
+        // IL18 Fig. 19's MERL1 (specular white phenolic): K_d = 0.34, n_i = 1.12, σ = 0.065.
+        for (name, expected, tol) in [
+            ("kd_g", 0.34, 0.03),
+            ("ni", 1.12, 0.01),
+            ("sigma", 0.092 / std::f64::consts::SQRT_2, 0.05),
+        ] {
+            let v = value(&out, name);
+            assert!((v / expected - 1.0).abs() < tol, "{name} = {v}\n{out}");
+        }
+        // The Lambert + Cook–Torrance model cannot follow IL's body term: a larger residual.
+        let o2 = facette(&["fit", s(&file), "--model", "plastic", "--samples", "3000"]);
+        ok(&o2);
+        let (r_il, r_plastic) = (
+            value(&out, "rms residual"),
+            value(&stdout(&o2), "rms residual"),
+        );
+        assert!(r_plastic > 2.0 * r_il, "{r_il} {r_plastic}");
+    }
+
+    #[test]
+    fn malformed_merl_files_are_clear_errors() {
+        let d = tmp();
+        let file = d.path().join("bad.binary");
+        std::fs::write(&file, [90u8, 0, 0, 0, 90, 0, 0, 0, 180, 0, 0, 0, 1, 2, 3]).unwrap();
+        let o = facette(&["fit", s(&file)]);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains("truncated"), "{}", stderr(&o));
+        let o = facette(&["fit", s(&d.path().join("missing.binary"))]);
+        assert!(
+            !o.status.success() && stderr(&o).contains("missing.binary"),
+            "{}",
+            stderr(&o)
+        );
+        let o = facette(&["fit", s(&file), "--model", "phong"]);
+        assert!(
+            stderr(&o).contains("valid values: il, plastic, kelemen"),
+            "{}",
+            stderr(&o)
+        );
+    }
+}

@@ -17,6 +17,8 @@
 //! difference vector at φ_d + π. Lookups take the bin that contains the pair; the writer
 //! evaluates a model at bin centres (θ_h at the centre of the index, (k + ½)² /90 · 90°).
 
+#![allow(clippy::needless_range_loop)] // channel loops index the per-channel scales
+
 use crate::atomic_file::write_atomically;
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::{Spectrum, Vec3};
@@ -73,7 +75,7 @@ pub fn bin_indices(index: usize) -> (usize, usize, usize) {
 /// θ_h index: ⌊√(θ_h/(π/2))·90⌋, clamped.
 #[inline]
 pub fn theta_h_index(theta_h: f64) -> usize {
-    if !(theta_h > 0.0) {
+    if theta_h.is_nan() || theta_h <= 0.0 {
         return 0;
     }
     ((theta_h / FRAC_PI_2).sqrt() * THETA_H_BINS as f64).min(THETA_H_BINS as f64 - 1.0) as usize

@@ -64,7 +64,8 @@ pub struct FitReport {
     /// Root mean square relative error |f̂ − f|/f over values with f > 10⁻³ 1/sr.
     pub rms_relative_error: f64,
     pub samples: usize,
-    /// Model evaluations (all starts, Jacobians included).
+    /// Residual evaluations of the Levenberg–Marquardt iterations, all starts (the
+    /// finite-difference Jacobians come on top).
     pub evaluations: usize,
     pub seconds: f64,
     pub converged: bool,
@@ -121,7 +122,7 @@ pub fn fit(
             residuals(family, &to_params(u), samples, metric)
                 .unwrap_or_else(|_| vec![f64::NAN; 3 * samples.len()])
         });
-        evaluations += out.evaluations * (params.len() + 1);
+        evaluations += out.evaluations;
         let p = to_params(&out.params);
         let r = residuals(family, &p, samples, metric)?;
         let ss: f64 = r.iter().map(|v| v * v).sum();

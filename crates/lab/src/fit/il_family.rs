@@ -80,6 +80,9 @@ pub enum IlFitEvaluation {
 /// Per-sample specular value (scalar: the interface is achromatic) and body integral.
 type Parts = Vec<(f64, f64)>;
 
+/// The parts of the last (n_i, σ, sample set) evaluated.
+type CachedParts = ((u64, u64, u64), Arc<Parts>);
+
 /// A fingerprint of a sample set's directions (FNV-1a over their bits): the cache must not
 /// serve the parts of one set for another of the same length.
 fn fingerprint(samples: &[FitSample]) -> u64 {
@@ -95,7 +98,7 @@ fn fingerprint(samples: &[FitSample]) -> u64 {
 pub struct IlFamily {
     pub distribution: IlDistribution,
     pub evaluation: IlFitEvaluation,
-    cache: Mutex<Option<((u64, u64, u64), Arc<Parts>)>>,
+    cache: Mutex<Option<CachedParts>>,
 }
 
 impl IlFamily {

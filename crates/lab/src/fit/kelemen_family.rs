@@ -16,8 +16,11 @@ use std::sync::{Arc, Mutex};
 /// QMC samples per entry of the specular-albedo table while fitting.
 pub const FIT_TABLE_SAMPLES: usize = 1024;
 
+/// The model of the last (m, η) evaluated.
+type CachedModel = ((u64, u64), Arc<Kelemen>);
+
 pub struct KelemenFamily {
-    cache: Mutex<Option<((u64, u64), Arc<Kelemen>)>>,
+    cache: Mutex<Option<CachedModel>>,
 }
 
 impl Default for KelemenFamily {

@@ -177,8 +177,19 @@ impl LineChart {
                 // Keep at most eight decades below the maximum: zeros of the data would
                 // otherwise squash the curves.
                 let lo = y0.max(y1 * 1e-8);
-                let (l0, l1) = (lo.log10().floor(), y1.log10() + 0.1);
-                (10f64.powf(l0), 10f64.powf(l1.max(l0 + 1.0)))
+                // The largest 1, 2 or 5 × 10^k below the data, so that at least one decade
+                // label stays visible without wasting most of a decade.
+                let k = lo.log10().floor();
+                let base = 10f64.powf(k);
+                let start = [5.0, 2.0, 1.0]
+                    .iter()
+                    .map(|m| m * base)
+                    .find(|&v| v <= lo)
+                    .unwrap_or(base);
+                let top = 10f64.powf(y1.log10() + 0.1);
+                let decade_inside = start <= base * 1.0001 || base * 10.0 <= top;
+                let start = if decade_inside { start } else { base };
+                (start, top)
             }
         };
         if self.equal_aspect {
