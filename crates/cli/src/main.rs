@@ -7,6 +7,7 @@ mod cmd_fit;
 mod cmd_il_approx;
 mod cmd_plot;
 mod cmd_render;
+mod cmd_reproduce;
 mod cmd_tabulate;
 mod cmd_validate;
 mod material_arg;
@@ -47,6 +48,8 @@ enum Command {
     Plot(cmd_plot::PlotArgs),
     /// Fit IL, plastic (Lambert + Cook–Torrance) or KSK01 to a measured MERL BRDF.
     Fit(cmd_fit::FitArgs),
+    /// Regenerate the papers' figures (SVG and PNG) and print their key numbers.
+    Reproduce(cmd_reproduce::ReproduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +63,7 @@ fn main() -> ExitCode {
         Command::IlApprox(a) => cmd_il_approx::run(a),
         Command::Plot(a) => cmd_plot::run(a),
         Command::Fit(a) => cmd_fit::run(a),
+        Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {
         Ok(code) => code,

@@ -5,6 +5,7 @@
 //! fitting models to measured data, and the reproductions of the papers' figures.
 
 pub mod atomic_file;
+pub mod figures;
 pub mod fit;
 pub mod il_approx_fit;
 pub mod least_squares;
