@@ -429,3 +429,89 @@ mod fit {
         );
     }
 }
+
+mod reproduce {
+    use super::*;
+
+    /// The number after `key` on the line that starts with `prefix`.
+    fn number_after(out: &str, prefix: &str, key: &str) -> f64 {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no line {prefix} in {out}"));
+        let i = line
+            .find(key)
+            .unwrap_or_else(|| panic!("no {key} in {line}"))
+            + key.len();
+        let t: String = line[i..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit() || "-+.e".contains(*c))
+            .collect();
+        t.parse()
+            .unwrap_or_else(|_| panic!("no number after {key} in {line}"))
+    }
+
+    #[test]
+    fn il18_fig7_and_ksk01_fig5_numbers() {
+        let d = tmp();
+        let o = facette(&["reproduce", "il18-fig7", "--quick", "-o", s(d.path())]);
+        ok(&o);
+        let out = stdout(&o);
+        // IL18 §3.3: without inter-reflections the rough surface loses more than 20 % at σ = 1;
+        // the flat surface (σ = 0) conserves energy; the V-cavity walk restores most of it.
+        let single = number_after(&out, "σ = 1:", "single scattering ");
+        let multiple = number_after(&out, "σ = 1:", "with inter-reflections ");
+        assert!(single < 0.8, "{out}");
+        assert!(multiple > 0.95 && multiple < 1.01, "{out}");
+        assert!(
+            (number_after(&out, "σ = 0:", "single scattering ") - 1.0).abs() < 0.01,
+            "{out}"
+        );
+        assert!(is_png(&d.path().join("il18-fig7.png")));
+        let svg = std::fs::read_to_string(d.path().join("il18-fig7.svg")).unwrap();
+        assert!(svg.contains("total reflectance") && svg.contains("with inter-reflections (IL_∞)"));
+
+        let o = facette(&["reproduce", "ksk01-fig5", "--quick", "-o", s(d.path())]);
+        ok(&o);
+        let out = stdout(&o);
+        let worst = number_after(&out, "largest |specular + matte − 1|", "89°]: ");
+        assert!(worst < 0.01, "{out}");
+    }
+
+    #[test]
+    fn cheap_figures_print_their_key_numbers() {
+        let d = tmp();
+        let o = facette(&["reproduce", "wmlt07-fig8", "-o", s(d.path())]);
+        ok(&o);
+        // D(0) = 1/(π α²) for all three distributions at matched widths (WMLT07 §5.2).
+        assert!(
+            stdout(&o).contains("Beckmann 7.9577, Phong 7.9577, GGX 7.9577"),
+            "{}",
+            stdout(&o)
+        );
+        let o = facette(&["reproduce", "ksk01-fig2", "--quick", "-o", s(d.path())]);
+        ok(&o);
+        // The off-specular peak lies beyond the mirror direction and moves with θ'.
+        let out = stdout(&o);
+        let shift = |p: &str| number_after(&out, p, "off-specular by ");
+        assert!(
+            shift("θ' = 67.5°") > shift("θ' = 22.5°") && shift("θ' = 22.5°") >= 0.0,
+            "{out}"
+        );
+        let o = facette(&["reproduce", "wmlt07-fig2", "--quick", "-o", s(d.path())]);
+        ok(&o);
+        // Rough transmission peaks beyond the Snell direction, more so at grazing incidence.
+        let out = stdout(&o);
+        let shift = |p: &str| number_after(&out, p, "shift ");
+        assert!(
+            shift("θ_i = 80°") > 5.0 && shift("θ_i = 0°").abs() < 1.0,
+            "{out}"
+        );
+        let o = facette(&["reproduce", "fig99", "-o", s(d.path())]);
+        assert!(
+            !o.status.success() && stderr(&o).contains("il18-fig7"),
+            "{}",
+            stderr(&o)
+        );
+    }
+}

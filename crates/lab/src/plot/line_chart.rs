@@ -144,7 +144,7 @@ impl LineChart {
         }
         let xr = match self.x_range {
             Some(r) => r,
-            None if x0 <= x1 => pad(x0, x1, 0.0),
+            None if x0 <= x1 => pad(x0, x1, if self.equal_aspect { 0.04 } else { 0.0 }),
             None => {
                 return Err(PlotError::Data(format!(
                     "{}: no finite data to plot",
@@ -177,18 +177,10 @@ impl LineChart {
                 // Keep at most eight decades below the maximum: zeros of the data would
                 // otherwise squash the curves.
                 let lo = y0.max(y1 * 1e-8);
-                // The largest 1, 2 or 5 × 10^k below the data, so that at least one decade
-                // label stays visible without wasting most of a decade.
-                let k = lo.log10().floor();
-                let base = 10f64.powf(k);
-                let start = [5.0, 2.0, 1.0]
-                    .iter()
-                    .map(|m| m * base)
-                    .find(|&v| v <= lo)
-                    .unwrap_or(base);
+                // Start at a power of ten: plotters places the sub-decade ticks (2…9 ×
+                // 10^k) upward from the first decade inside the range.
+                let start = 10f64.powf(lo.log10().floor());
                 let top = 10f64.powf(y1.log10() + 0.1);
-                let decade_inside = start <= base * 1.0001 || base * 10.0 <= top;
-                let start = if decade_inside { start } else { base };
                 (start, top)
             }
         };
@@ -235,8 +227,11 @@ impl LineChart {
                 self.draw_body(&mut chart, yr)
             }
             Scale::Log => {
+                // Drawn as log10(y) on a linear axis labelled with 10^v: plotters' log
+                // axis labels only whole decades and sub-decades above the first decade,
+                // which leaves short ranges unlabelled.
                 let mut chart = b
-                    .build_cartesian_2d(xr.0..xr.1, (yr.0..yr.1).log_scale())
+                    .build_cartesian_2d(xr.0..xr.1, yr.0.log10()..yr.1.log10())
                     .map_err(draw_err)?;
                 self.draw_body(&mut chart, yr)
             }
@@ -251,7 +246,15 @@ impl LineChart {
     where
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let fmt_y = |v: &f64| fmt_tick(*v);
+        let log = self.y_scale == Scale::Log;
+        let fmt_y = move |v: &f64| {
+            if log {
+                fmt_tick(10f64.powf(*v))
+            } else {
+                fmt_tick(*v)
+            }
+        };
+        let ty = move |y: f64| if log { y.log10() } else { y };
         chart
             .configure_mesh()
             .x_desc(self.x_label.as_str())
@@ -261,16 +264,18 @@ impl LineChart {
             .axis_desc_style(("sans-serif", 16))
             .label_style(("sans-serif", 13))
             .light_line_style(RGBColor(235, 235, 235))
+            .y_labels(if log { 8 } else { 10 })
             .draw()
             .map_err(draw_err)?;
         let clip = |y: f64| match self.y_scale {
-            Scale::Log => y > 0.0 && y.is_finite(),
+            // Below the axis on a log scale: a gap, not a line along the bottom edge.
+            Scale::Log => y >= yr.0 && y.is_finite(),
             Scale::Linear => y.is_finite(),
         };
         let mut legend = false;
         for g in &self.guides {
             let style = ShapeStyle::from(&RGBColor(90, 90, 90)).stroke_width(1);
-            let pts = vec![(g.x, yr.0), (g.x, yr.1)];
+            let pts = vec![(g.x, ty(yr.0)), (g.x, ty(yr.1))];
             let s = chart
                 .draw_series(DashedLineSeries::new(pts, 4, 4, style))
                 .map_err(draw_err)?;
@@ -291,7 +296,7 @@ impl LineChart {
             let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
             for &(x, y) in &s.points {
                 if x.is_finite() && clip(y) {
-                    segments.last_mut().expect("non-empty").push((x, y));
+                    segments.last_mut().expect("non-empty").push((x, ty(y)));
                 } else if !segments.last().expect("non-empty").is_empty() {
                     segments.push(Vec::new());
                 }
