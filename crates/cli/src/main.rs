@@ -3,9 +3,12 @@
 
 mod cmd_albedo;
 mod cmd_eval;
+mod cmd_fit;
 mod cmd_il_approx;
 mod cmd_merge;
+mod cmd_plot;
 mod cmd_render;
+mod cmd_reproduce;
 mod cmd_tabulate;
 mod cmd_validate;
 mod material_arg;
@@ -44,6 +47,12 @@ enum Command {
     Tabulate(cmd_tabulate::TabulateArgs),
     /// Fit or measure the approximate interfaced-Lambertian body term (IL18 §4.2).
     IlApprox(cmd_il_approx::IlApproxArgs),
+    /// Plot a material: incidence-plane slices, polar lobes, hemisphere maps, albedo; or an IL body table against its quadrature.
+    Plot(cmd_plot::PlotArgs),
+    /// Fit IL, plastic (Lambert + Cook–Torrance) or KSK01 to a measured MERL BRDF.
+    Fit(cmd_fit::FitArgs),
+    /// Regenerate the papers' figures (SVG and PNG) and print their key numbers.
+    Reproduce(cmd_reproduce::ReproduceArgs),
 }
 
 fn main() -> ExitCode {
@@ -56,6 +65,9 @@ fn main() -> ExitCode {
         Command::Validate(a) => cmd_validate::run(a),
         Command::Tabulate(a) => cmd_tabulate::run(a),
         Command::IlApprox(a) => cmd_il_approx::run(a),
+        Command::Plot(a) => cmd_plot::run(a),
+        Command::Fit(a) => cmd_fit::run(a),
+        Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {
         Ok(code) => code,

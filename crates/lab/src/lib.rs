@@ -1,8 +1,13 @@
 //! # facette-lab
 //!
 //! What a researcher uses around a BRDF: nonlinear least-squares fitting, the fit of the
-//! approximate interfaced-Lambertian body term, and (as they land) plots, measured-data
-//! readers and paper reproductions.
+//! approximate interfaced-Lambertian body term, plots, the MERL measured-data format,
+//! fitting models to measured data, and the reproductions of the papers' figures.
 
+pub mod atomic_file;
+pub mod figures;
+pub mod fit;
 pub mod il_approx_fit;
 pub mod least_squares;
+pub mod merl;
+pub mod plot;
