@@ -670,3 +670,25 @@ fn table_parts_merge_into_the_same_table_file() {
         stderr(&o)
     );
 }
+
+/// `facette eval … | head -1`: the reader closes the pipe early; facette stops quietly with
+/// the shell's SIGPIPE status (141) instead of printing an error or a panic.
+#[test]
+fn output_into_a_closed_pipe_exits_quietly() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args(["eval", "--material", "{type=\"lambert\"}"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close our end of stdout before facette writes: every write then hits a broken pipe.
+    drop(child.stdout.take());
+    let mut stdin = child.stdin.take().unwrap();
+    let line = "30,0,30,180\n".repeat(20_000);
+    let _ = stdin.write_all(line.as_bytes());
+    drop(stdin);
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(141), "{}", stderr(&o));
+    assert!(stderr(&o).is_empty(), "{}", stderr(&o));
+}
