@@ -1,13 +1,10 @@
 //! `facette fit`: fits a model to a measured BRDF in the MERL binary format and plots
 //! measured against fitted slices at θ_i = 30° and 70° (IL18 Fig. 19).
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use facette_lab::fit::slices::fit_slices;
-use facette_lab::fit::{
-    fit, select_samples, ErrorMetric, IlDistribution, IlFamily, IlFitEvaluation, KelemenFamily,
-    ModelFamily, PlasticFamily,
-};
+use facette_lab::fit::FitOptions;
 use facette_lab::merl::MerlBrdf;
 use facette_lab::plot::{save_figure, Format};
 use std::path::PathBuf;
@@ -51,65 +48,31 @@ pub fn run(a: FitArgs) -> Result<ExitCode> {
     if let Some(o) = &a.output {
         Format::of(o)?;
     }
-    if a.samples < 10 {
-        bail!("--samples must be at least 10");
-    }
-    if !(a.max_theta > 10.0 && a.max_theta <= 90.0) {
-        bail!("--max-theta {}: expected (10, 90] degrees", a.max_theta);
-    }
-    let metric = ErrorMetric::parse(&a.error).with_context(|| {
-        format!(
-            "unknown --error `{}`; valid values: {}",
-            a.error,
-            ErrorMetric::NAMES.join(", ")
-        )
-    })?;
-    let family: Box<dyn ModelFamily> = match a.model.as_str() {
-        "il" => {
-            let d = IlDistribution::parse(&a.distribution).with_context(|| {
-                format!(
-                    "unknown --distribution `{}` for il; valid values: {}",
-                    a.distribution,
-                    IlDistribution::NAMES.join(", ")
-                )
-            })?;
-            let ev = match a.il_evaluation.as_str() {
-                "quadrature" => {
-                    if a.il_samples < 8 {
-                        bail!("--il-samples must be at least 8");
-                    }
-                    IlFitEvaluation::Quadrature(a.il_samples)
-                }
-                "approx" => IlFitEvaluation::Approx,
-                other => {
-                    bail!("unknown --il-evaluation `{other}`; valid values: quadrature, approx")
-                }
-            };
-            Box::new(IlFamily::new(d, ev))
-        }
-        "plastic" => Box::new(PlasticFamily {
-            ggx: match a.distribution.as_str() {
-                "beckmann" => false,
-                "ggx" => true,
-                other => bail!(
-                    "unknown --distribution `{other}` for plastic; valid values: beckmann, ggx"
-                ),
-            },
-        }),
-        "kelemen" => Box::new(KelemenFamily::default()),
-        other => bail!("unknown --model `{other}`; valid values: il, plastic, kelemen"),
+    let options = FitOptions {
+        model: a.model.clone(),
+        distribution: a.distribution.clone(),
+        il_evaluation: a.il_evaluation.clone(),
+        il_samples: a.il_samples,
+        error: a.error.clone(),
+        samples: a.samples,
+        max_theta_deg: a.max_theta,
+        seed: a.seed,
     };
+    // Names and ranges are checked before the file is read.
+    options.check()?;
+    options.metric()?;
+    options.family()?;
     let merl = MerlBrdf::load(&a.file)?;
-    let samples = select_samples(&merl, a.max_theta, a.samples, a.seed);
+    let fitted = options.fit(&merl).context("fit")?;
+    let r = &fitted.report;
     println!(
-        "{}: {} valid bins of {}, fitting {} values with θ ≤ {}°",
+        "{}: {} valid bins of {}, fitted {} values with θ ≤ {}°",
         a.file.display(),
-        merl.valid_bins(),
+        fitted.valid_bins,
         facette_lab::merl::BINS,
-        samples.len(),
+        fitted.used_samples,
         a.max_theta
     );
-    let r = fit(family.as_ref(), &samples, metric).context("fit")?;
     println!("model: {}", r.family);
     println!("error metric: {}", r.metric.name());
     for (p, v) in r.parameters.iter().zip(&r.values) {
@@ -140,7 +103,7 @@ pub fn run(a: FitArgs) -> Result<ExitCode> {
             "stopped before convergence"
         }
     );
-    if let Some(t) = family.material_toml(&r.values) {
+    if let Some(t) = fitted.material_toml() {
         println!("material: {t}");
     }
     if let Some(o) = &a.output {
@@ -151,7 +114,7 @@ pub fn run(a: FitArgs) -> Result<ExitCode> {
             .unwrap_or("measured");
         let fig = fit_slices(
             &merl,
-            family.as_ref(),
+            fitted.family.as_ref(),
             &r.values,
             &format!("{name}: measured vs {} fit", a.model),
             &[30.0, 70.0],

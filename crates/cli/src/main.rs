@@ -5,6 +5,7 @@ mod cmd_albedo;
 mod cmd_eval;
 mod cmd_fit;
 mod cmd_il_approx;
+mod cmd_measure;
 mod cmd_merge;
 mod cmd_plot;
 mod cmd_render;
@@ -51,6 +52,8 @@ enum Command {
     Plot(cmd_plot::PlotArgs),
     /// Fit IL, plastic (Lambert + Cook–Torrance) or KSK01 to a measured MERL BRDF.
     Fit(cmd_fit::FitArgs),
+    /// Write a material as a measured BRDF in the MERL binary format (virtual gonioreflectometer).
+    Measure(cmd_measure::MeasureArgs),
     /// Regenerate the papers' figures (SVG and PNG) and print their key numbers.
     Reproduce(cmd_reproduce::ReproduceArgs),
 }
@@ -87,6 +90,7 @@ fn main() -> ExitCode {
         Command::IlApprox(a) => cmd_il_approx::run(a),
         Command::Plot(a) => cmd_plot::run(a),
         Command::Fit(a) => cmd_fit::run(a),
+        Command::Measure(a) => cmd_measure::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {

@@ -407,6 +407,47 @@ mod fit {
         assert!(r_plastic > 2.0 * r_il, "{r_il} {r_plastic}");
     }
 
+    /// `facette measure` writes the file the library's virtual measurement makes, noise
+    /// included, and refuses a bad noise level without writing anything.
+    #[test]
+    fn measure_writes_the_material_as_a_merl_file() {
+        let d = tmp();
+        let (cli, lib) = (d.path().join("cli.binary"), d.path().join("lib.binary"));
+        let material =
+            r#"{type = "conductor", material = "Au", distribution = "ggx", alpha = 0.3}"#;
+        let o = facette(&[
+            "measure",
+            "--material",
+            material,
+            "--noise",
+            "0.02",
+            "--seed",
+            "5",
+            "-o",
+            s(&cli),
+        ]);
+        ok(&o);
+        let b = build_material(&parse_inline_table(material).unwrap()).unwrap();
+        facette_lab::measure::measure_material(b.as_ref(), 0.02, 5)
+            .save(&lib)
+            .unwrap();
+        assert_eq!(std::fs::read(&cli).unwrap(), std::fs::read(&lib).unwrap());
+        let m = MerlBrdf::load(&cli).unwrap();
+        assert!(stdout(&o).contains(&format!("{} valid bins", m.valid_bins())));
+        let bad = d.path().join("bad.binary");
+        let o = facette(&[
+            "measure",
+            "--material",
+            material,
+            "--noise",
+            "2",
+            "-o",
+            s(&bad),
+        ]);
+        assert!(!o.status.success() && stderr(&o).contains("--noise"));
+        assert!(!bad.exists());
+    }
+
     #[test]
     fn malformed_merl_files_are_clear_errors() {
         let d = tmp();

@@ -8,6 +8,7 @@
 
 mod arrays;
 mod errors;
+mod fit;
 mod material;
 mod parts;
 mod render;
@@ -29,6 +30,8 @@ fn _facette(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parts::tabulate, m)?)?;
     m.add_function(wrap_pyfunction!(parts::tabulate_part, m)?)?;
     m.add_function(wrap_pyfunction!(parts::merge_table_parts, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(fit::measure, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -53,6 +53,13 @@ pub struct Material {
     bsdf: Arc<dyn Bsdf>,
 }
 
+impl Material {
+    /// The material's BSDF, shared.
+    pub(crate) fn bsdf(&self) -> Arc<dyn Bsdf> {
+        self.bsdf.clone()
+    }
+}
+
 #[pymethods]
 impl Material {
     #[new]

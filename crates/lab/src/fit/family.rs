@@ -35,7 +35,7 @@ impl Parameter {
 }
 
 /// A model family that can be fitted.
-pub trait ModelFamily: Sync {
+pub trait ModelFamily: Send + Sync {
     /// Name used on the command line and in reports.
     fn name(&self) -> String;
 

@@ -32,6 +32,8 @@ __all__ = [
     "tabulate",
     "tabulate_part",
     "merge_table_parts",
+    "fit",
+    "measure",
     "__version__",
 ]
 
@@ -105,6 +107,12 @@ class Material:
         ``transmittance_stderr`` — the numbers of ``facette albedo``."""
         t = [float(x) for x in _np.atleast_1d(_np.asarray(theta_i, dtype=_np.float64))]
         return self._m.albedo(t, samples, seed)
+
+    def to_merl(self, path, noise=0.0, seed=1):
+        """Writes this material as a measured BRDF in the MERL binary format (``facette
+        measure``): f at every bin centre, with multiplicative Gaussian noise of relative
+        deviation ``noise``. Returns the number of valid bins."""
+        return measure(self, path, noise, seed)
 
     def validate(self, samples=200_000, seed=1):
         """Runs every BSDF check of ``facette validate --material``; returns a
@@ -183,3 +191,50 @@ def read_image(path, linear=False):
     import os
 
     return _facette.read_image(os.fspath(path), linear)
+
+
+def fit(
+    path,
+    model="il",
+    distribution="beckmann",
+    il_evaluation="quadrature",
+    il_samples=128,
+    error="log",
+    samples=4000,
+    max_theta=80.0,
+    seed=1,
+    output=None,
+):
+    """Fits a model to a measured BRDF in the MERL binary format (``facette fit``, same
+    options and defaults): ``model`` "il", "plastic" or "kelemen"; ``distribution``
+    "beckmann", "ggx" (or "gaussian" for il); ``error`` "log" or "cosine".
+
+    Returns a dict: ``model``, ``metric``, ``parameters`` {name: value}, ``units``,
+    ``rms_residual``, ``rms_relative_error``, ``evaluations``, ``seconds``, ``converged``,
+    ``material`` (the fitted material as a TOML inline table, or None), ``valid_bins``,
+    ``samples``. With ``output`` (.svg/.png) it also plots measured vs fitted slices at
+    θ_i = 30° and 70° (IL18 Fig. 19)."""
+    import os
+
+    return _facette.fit(
+        os.fspath(path),
+        model,
+        distribution,
+        il_evaluation,
+        il_samples,
+        error,
+        samples,
+        max_theta,
+        seed,
+        None if output is None else os.fspath(output),
+    )
+
+
+def measure(material, path, noise=0.0, seed=1):
+    """Writes ``material`` (a ``Material``, TOML text or dict) as a MERL file at ``path``;
+    returns the number of valid bins. See ``Material.to_merl``."""
+    import os
+
+    if not isinstance(material, Material):
+        material = Material(material)
+    return _facette.measure(material._m, os.fspath(path), float(noise), int(seed))
