@@ -176,9 +176,9 @@ pub struct ObjectDesc {
     pub two_sided: bool,
     #[serde(default)]
     pub flip_normals: bool,
-    /// Mesh files: drop the vertex normals (Mitsuba XML's `face_normals`).
+    /// Mesh files: which shading normals (Mitsuba XML computes missing ones).
     #[serde(skip)]
-    pub face_normals: bool,
+    pub mesh_normals: MeshNormals,
     /// OBJ files: whether `v ↦ 1 − v` (Mitsuba XML's `flip_tex_coords`); `None` is the
     /// default (flipped).
     #[serde(skip)]
@@ -219,4 +219,17 @@ pub struct LightDesc {
     /// Rotation of the environment (transform steps; only rotations are allowed).
     #[serde(default)]
     pub transform: Vec<toml::Table>,
+}
+
+/// Shading normals of a mesh file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MeshNormals {
+    /// The file's normals, or the flat triangle normals where it has none (TOML scenes).
+    #[default]
+    AsStored,
+    /// Flat triangle normals, ignoring the file's (Mitsuba's `face_normals`).
+    Face,
+    /// The file's normals, or angle-weighted vertex normals where it has none (Mitsuba's
+    /// default).
+    ComputedIfMissing,
 }

@@ -372,8 +372,16 @@ pub(crate) fn build(ctx: &Ctx, desc: SceneDesc, source_hash: u64) -> Result<Scen
                     _ => crate::geometry::mesh_io::read_mesh(&path),
                 }
                 .map_err(|x| e(x.to_string()))?;
-                if o.face_normals {
-                    data.normals = None;
+                match o.mesh_normals {
+                    MeshNormals::AsStored => {}
+                    MeshNormals::Face => data.normals = None,
+                    MeshNormals::ComputedIfMissing => {
+                        if data.normals.is_none() {
+                            super::mitsuba::vertex_normals::add_vertex_normals(
+                                &mut data, &to_world,
+                            );
+                        }
+                    }
                 }
                 let mesh = data
                     .into_mesh(&to_world, o.flip_normals)

@@ -13,7 +13,8 @@
 //! - [`sensor`], [`integrator`], [`bsdf`], [`texture`], [`shape`], [`emitter`]: one plugin
 //!   kind each, mapped onto the description's camera, film, integrator, materials, objects
 //!   and lights;
-//! - [`translator`]: the state they share (ids, locations, materials, warnings).
+//! - [`translator`]: the state they share (ids, locations, materials, warnings);
+//! - [`vertex_normals`]: Mitsuba's vertex normals for meshes stored without.
 //!
 //! Errors name the file and line of the element at fault; parameters that only change the
 //! noise (a sampler type, say) are warnings, printed once, in [`Scene::warnings`].
@@ -30,6 +31,7 @@ mod texture;
 mod transform;
 mod translator;
 mod values;
+pub(crate) mod vertex_normals;
 mod xml;
 
 use super::description::SceneDesc;

@@ -13,7 +13,7 @@ use super::bsdf::material;
 use super::emitter::{area_radiance, matrix_step};
 use super::plugin::Plugin;
 use super::translator::Translator;
-use crate::scene::description::{MaterialRef, ObjectDesc};
+use crate::scene::description::{MaterialRef, MeshNormals, ObjectDesc};
 use crate::scene::SceneError;
 use std::rc::Rc;
 use toml::Spanned;
@@ -47,7 +47,7 @@ pub(crate) fn object(
         emission: None,
         two_sided: false,
         flip_normals: p.boolean("flip_normals")?.unwrap_or(false),
-        face_normals: false,
+        mesh_normals: MeshNormals::AsStored,
         flip_tex_coords: None,
     };
     if let Some(m) = p.transform("to_world")? {
@@ -64,7 +64,11 @@ pub(crate) fn object(
                     .ok_or_else(|| p.err("the file path is not valid UTF-8"))?
                     .to_string(),
             );
-            o.face_normals = p.boolean("face_normals")?.unwrap_or(false);
+            o.mesh_normals = if p.boolean("face_normals")?.unwrap_or(false) {
+                MeshNormals::Face
+            } else {
+                MeshNormals::ComputedIfMissing
+            };
             keys.extend(["filename", "face_normals"]);
             if kind == "obj" {
                 o.flip_tex_coords = p.boolean("flip_tex_coords")?;
