@@ -446,6 +446,13 @@ fn emitters_map_to_lights_with_their_values() {
     }
     assert_eq!(saw, 31);
     assert_eq!(s.shape_light[0], Some(0));
+    // An emitter without a BSDF is black, as in Mitsuba (other shapes get diffuse 0.5).
+    assert_material(
+        &s,
+        s.shape_material[0] as usize,
+        "type = \"lambert\"\nreflectance = 0",
+        Vec2::ZERO,
+    );
     let s = load(&scene_xml(
         r#"<emitter type="constant"><rgb name="radiance" value="0.25"/></emitter>"#,
     ));

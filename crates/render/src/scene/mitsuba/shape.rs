@@ -5,7 +5,7 @@
 //!
 //! | Mitsuba | facette |
 //! |---|---|
-//! | every shape: `to_world`, `flip_normals`, a `<bsdf>` (default: `diffuse` 0.5, as in Mitsuba), an `area` `<emitter>` | `transform`, `flip_normals`, `material`, `emission` |
+//! | every shape: `to_world`, `flip_normals`, a `<bsdf>` (default, as in Mitsuba: `diffuse` 0.5, or black for an emitter), an `area` `<emitter>` | `transform`, `flip_normals`, `material`, `emission` |
 //! | `obj` (`filename`, `face_normals`, `flip_tex_coords`), `ply` (`filename`, `face_normals`) | `obj`, `ply` |
 //! | `sphere` (`center`, `radius`), `rectangle`, `disk`, `cube` | the same |
 
@@ -21,8 +21,9 @@ use toml::Spanned;
 /// The shape plugins facette reads.
 pub(crate) const MITSUBA_SHAPES: &[&str] = &["obj", "ply", "sphere", "rectangle", "disk", "cube"];
 
-/// Name of the material given to shapes without a BSDF (Mitsuba's default BSDF).
+/// Names of the materials given to shapes without a BSDF (Mitsuba's defaults).
 const DEFAULT_MATERIAL: &str = "default diffuse";
+const DEFAULT_EMITTER_MATERIAL: &str = "default emitter (black)";
 
 /// A scene-level shape as a facette object.
 pub(crate) fn object(
@@ -89,7 +90,7 @@ pub(crate) fn object(
     }
     let (name, at) = match &bsdf {
         Some(b) => (material(cx, b)?, b.pos.clone()),
-        None => (default_material(cx, p), p.pos.clone()),
+        None => (default_material(cx, p, emitter.is_some()), p.pos.clone()),
     };
     let span = cx.span(&at);
     o.material = Some(Spanned::new(span, MaterialRef::Name(name)));
@@ -98,15 +99,20 @@ pub(crate) fn object(
     Ok(Spanned::new(span, o))
 }
 
-/// Mitsuba gives a shape without a BSDF a `diffuse` one of reflectance 0.5 (emitters too).
-fn default_material(cx: &mut Translator, p: &Plugin) -> String {
-    if !cx.materials.contains_key(DEFAULT_MATERIAL) {
+/// Mitsuba gives a shape without a BSDF a `diffuse` one of reflectance 0.5, and an
+/// emitting shape a black one.
+fn default_material(cx: &mut Translator, p: &Plugin, emitter: bool) -> String {
+    let (name, reflectance) = if emitter {
+        (DEFAULT_EMITTER_MATERIAL, 0.0)
+    } else {
+        (DEFAULT_MATERIAL, 0.5)
+    };
+    if !cx.materials.contains_key(name) {
         let mut t = toml::Table::new();
         t.insert("type".into(), "lambert".into());
-        t.insert("reflectance".into(), toml::Value::Float(0.5));
+        t.insert("reflectance".into(), toml::Value::Float(reflectance));
         let span = cx.span(&p.pos);
-        cx.materials
-            .insert(DEFAULT_MATERIAL.into(), Spanned::new(span, t));
+        cx.materials.insert(name.into(), Spanned::new(span, t));
     }
-    DEFAULT_MATERIAL.into()
+    name.into()
 }
