@@ -27,8 +27,8 @@ enum StrategyArg {
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file: facette TOML (docs/scene-format.md) or Mitsuba 3 XML, `.xml`
-    /// (docs/mitsuba-scenes.md).
+    /// Scene file: facette TOML or Mitsuba 3 XML, `.xml` (docs/scene-format.md, the
+    /// latter in its section "Mitsuba scenes").
     scene: PathBuf,
     /// Mitsuba XML scenes: gives `$NAME` a value, overriding the scene's
     /// `<default name="NAME">` (repeatable).

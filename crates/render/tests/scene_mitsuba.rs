@@ -221,6 +221,15 @@ fn the_sensor_gives_mitsubas_camera_rays() {
     );
     let (r, _) = s.camera.generate_ray(384.0, 0.0, Vec2::ZERO);
     assert!((r.dir.angle_between(Vec3::Z).to_degrees() - 15.0).abs() < 1e-9);
+    // A Gaussian rfilter with its own stddev keeps Mitsuba's 4σ radius.
+    let s = load(
+        r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm">
+        <rfilter type="gaussian"><float name="stddev" value="0.3"/></rfilter></film></sensor></scene>"#,
+    );
+    assert_eq!(
+        s.film.filter,
+        facette_render::film::Filter::gaussian(0.3, 4.0 * 0.3)
+    );
     // focal_length: 50 mm on the 36×24 mm diagonal, x_fov = 38.1848° at 768×576 (what
     // Mitsuba 3 reports).
     let s = load(

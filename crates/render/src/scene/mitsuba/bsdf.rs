@@ -342,7 +342,7 @@ fn plastic(
             if !nonlinear {
                 cx.warn(
                     &p.pos,
-                    format!("{} with a textured diffuse_reflectance and nonlinear=false: the texture is taken as the substrate albedo (as with nonlinear=true); see docs/mitsuba-scenes.md", p.describe()),
+                    format!("{} with a textured diffuse_reflectance and nonlinear=false: the texture is taken as the substrate albedo (as with nonlinear=true); see docs/scene-format.md, section Mitsuba scenes", p.describe()),
                 );
             }
             t.insert("kd".into(), toml::Value::Table(texture_table(cx, &tex)?));

@@ -1,7 +1,7 @@
 //! Mitsuba 3 XML scenes, read into facette's own scene description so that everything
 //! after loading — validation, geometry, materials, lights, camera, rendering — is shared
-//! with TOML scenes. docs/mitsuba-scenes.md lists the supported subset, the mapping of
-//! every plugin and what differs.
+//! with TOML scenes. docs/scene-format.md (section "Mitsuba scenes") lists the supported
+//! subset, the mapping of every plugin and what differs.
 //!
 //! The stages, one file each:
 //! - [`xml`]: the files as element trees that keep every element's file and line;
