@@ -6,7 +6,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use facette_render::integrator::Strategy;
 use facette_render::render::{render, RenderOptions};
-use facette_render::scene::load_scene;
+use facette_render::scene::{load_scene_with, LoadOptions};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -27,8 +27,13 @@ enum StrategyArg {
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML; see docs/scene-format.md).
+    /// Scene file: facette TOML or Mitsuba 3 XML, `.xml` (docs/scene-format.md, the
+    /// latter in its section "Mitsuba scenes").
     scene: PathBuf,
+    /// Mitsuba XML scenes: gives `$NAME` a value, overriding the scene's
+    /// `<default name="NAME">` (repeatable).
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
+    define: Vec<(String, String)>,
     /// Output image: `.exr` (linear float) or `.png` (sRGB, 8 bit, film exposure applied).
     /// Defaults to the scene's name with `.exr`, in the current directory.
     #[arg(short, long, value_name = "FILE")]
@@ -110,8 +115,14 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
     }
 
     let load_start = Instant::now();
-    let scene = load_scene(&a.scene)?;
+    let options = LoadOptions {
+        defines: a.define.clone(),
+    };
+    let scene = load_scene_with(&a.scene, &options)?;
     let load_secs = load_start.elapsed().as_secs_f64();
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
     let spp = a.spp.unwrap_or(scene.film.spp);
     let (w, h) = (scene.film.width, scene.film.height);
 
@@ -221,6 +232,16 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// `NAME=VALUE` of `-D`.
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, value)) if !name.trim().is_empty() => {
+            Ok((name.trim().to_string(), value.to_string()))
+        }
+        _ => Err(format!("`{s}` is not NAME=VALUE")),
+    }
 }
 
 /// Fails before rendering when the output could not be written: an unknown extension or a

@@ -1,5 +1,8 @@
 //! The scene file as written (TOML), deserialized with serde; `load.rs` validates it and
 //! builds the [`Scene`](super::Scene). `docs/scene-format.md` documents every key.
+//!
+//! Mitsuba XML scenes are translated into this same description (`super::mitsuba`); the
+//! few things only they can say are `#[serde(skip)]` fields, out of reach of TOML.
 
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -65,6 +68,10 @@ pub struct CameraDesc {
     pub aperture_radius: f64,
     #[serde(default)]
     pub focus_distance: Option<f64>,
+    /// Camera-to-world transform replacing `look_at(position, target, up)` (Mitsuba XML:
+    /// the sensor's `to_world`, which may mirror the image).
+    #[serde(skip)]
+    pub to_world: Option<crate::geometry::Transform>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -169,6 +176,13 @@ pub struct ObjectDesc {
     pub two_sided: bool,
     #[serde(default)]
     pub flip_normals: bool,
+    /// Mesh files: which shading normals (Mitsuba XML computes missing ones).
+    #[serde(skip)]
+    pub mesh_normals: MeshNormals,
+    /// OBJ files: whether `v ↦ 1 − v` (Mitsuba XML's `flip_tex_coords`); `None` is the
+    /// default (flipped).
+    #[serde(skip)]
+    pub flip_tex_coords: Option<bool>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -205,4 +219,17 @@ pub struct LightDesc {
     /// Rotation of the environment (transform steps; only rotations are allowed).
     #[serde(default)]
     pub transform: Vec<toml::Table>,
+}
+
+/// Shading normals of a mesh file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MeshNormals {
+    /// The file's normals, or the flat triangle normals where it has none (TOML scenes).
+    #[default]
+    AsStored,
+    /// Flat triangle normals, ignoring the file's (Mitsuba's `face_normals`).
+    Face,
+    /// The file's normals, or angle-weighted vertex normals where it has none (Mitsuba's
+    /// default).
+    ComputedIfMissing,
 }

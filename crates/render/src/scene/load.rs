@@ -1,5 +1,6 @@
-//! Loading a TOML scene: parse (serde, with spans), validate every value, build geometry,
-//! materials, lights and camera. Every error names the file and line.
+//! Loading a scene: parse the TOML (serde, with spans) — or translate a Mitsuba XML file
+//! into the same description (`super::mitsuba`) — then validate every value and build
+//! geometry, materials, lights and camera. Every error names the file and line.
 
 use super::description::*;
 use super::{FilmSettings, IntegratorSettings, Scene};
@@ -30,49 +31,64 @@ pub struct SceneError {
     pub message: String,
 }
 
-struct Ctx<'a> {
-    file: &'a Path,
-    source: &'a str,
-    base_dir: PathBuf,
+/// A place in a scene file, for descriptions whose elements come from several files
+/// (Mitsuba XML with `<include>`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Location {
+    pub file: PathBuf,
+    pub line: usize,
+}
+
+/// What the spans of a [`SceneDesc`] index.
+pub(crate) enum Spans<'a> {
+    /// Byte ranges of the TOML text of `file`.
+    Text { file: &'a Path, source: &'a str },
+    /// `i..i + 1` is entry `i` of `locations` (a description translated from Mitsuba XML);
+    /// errors without a span name `file`, the main scene file.
+    Table {
+        file: &'a Path,
+        locations: &'a [Location],
+    },
+}
+
+pub(crate) struct Ctx<'a> {
+    pub spans: Spans<'a>,
+    /// Directory that relative paths of the description are resolved against.
+    pub base_dir: PathBuf,
 }
 
 impl Ctx<'_> {
-    fn line_of(&self, offset: usize) -> usize {
-        self.source[..offset.min(self.source.len())]
-            .matches('\n')
-            .count()
-            + 1
-    }
-
     fn err(&self, span: Option<std::ops::Range<usize>>, message: impl Into<String>) -> SceneError {
+        let (file, line) = match (&self.spans, span) {
+            (Spans::Text { file, source }, Some(s)) => (
+                file.to_path_buf(),
+                Some(source[..s.start.min(source.len())].matches('\n').count() + 1),
+            ),
+            (Spans::Table { file, locations }, Some(s)) => match locations.get(s.start) {
+                Some(l) => (l.file.clone(), Some(l.line)),
+                None => (file.to_path_buf(), None),
+            },
+            (Spans::Text { file, .. } | Spans::Table { file, .. }, None) => {
+                (file.to_path_buf(), None)
+            }
+        };
         SceneError {
-            file: self.file.to_path_buf(),
-            line: span.map(|s| self.line_of(s.start)),
+            file,
+            line,
             message: message.into(),
         }
     }
 }
 
-/// Loads a scene file.
-pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let source = std::fs::read_to_string(path).map_err(|e| SceneError {
-        file: path.to_path_buf(),
-        line: None,
-        message: format!("cannot read the scene file: {e}"),
-    })?;
-    load_scene_str(&source, path)
-}
-
-/// Loads a scene from its text; `path` names it in errors and anchors relative paths.
+/// Loads a TOML scene from its text; `path` names it in errors and anchors relative paths.
 pub fn load_scene_str(source: &str, path: &Path) -> Result<Scene, SceneError> {
     let ctx = Ctx {
-        file: path,
-        source,
+        spans: Spans::Text { file: path, source },
         base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
     };
     let desc: SceneDesc =
         toml::from_str(source).map_err(|e| ctx.err(e.span(), e.message().to_string()))?;
-    build(&ctx, desc, source)
+    build(&ctx, desc, fnv1a(source.as_bytes()))
 }
 
 fn vec3(a: [f64; 3]) -> Vec3 {
@@ -182,7 +198,9 @@ pub fn parse_transform(steps: &[toml::Table]) -> Result<Transform, String> {
     Ok(t)
 }
 
-fn build(ctx: &Ctx, desc: SceneDesc, source: &str) -> Result<Scene, SceneError> {
+/// Validates a description and builds the scene; `source_hash` identifies the scene's
+/// source (see [`Scene::source_hash`]).
+pub(crate) fn build(ctx: &Ctx, desc: SceneDesc, source_hash: u64) -> Result<Scene, SceneError> {
     // Film and integrator.
     let film_span = desc.film.as_ref().map(|f| f.span());
     let f = desc.film.map(|f| f.into_inner()).unwrap_or_default();
@@ -264,8 +282,12 @@ fn build(ctx: &Ctx, desc: SceneDesc, source: &str) -> Result<Scene, SceneError> 
             )
         })?,
     };
-    let to_world = Transform::look_at(position, target, up)
-        .map_err(|e| ctx.err(Some(cam_span.clone()), format!("camera: {e}")))?;
+    // A translated Mitsuba sensor brings its own frame (which may mirror the image).
+    let to_world = match c.to_world {
+        Some(t) => t,
+        None => Transform::look_at(position, target, up)
+            .map_err(|e| ctx.err(Some(cam_span.clone()), format!("camera: {e}")))?,
+    };
     if !(c.aperture_radius >= 0.0 && c.aperture_radius.is_finite()) {
         return Err(ctx.err(Some(cam_span), "`aperture_radius` must be ≥ 0"));
     }
@@ -344,12 +366,30 @@ fn build(ctx: &Ctx, desc: SceneDesc, source: &str) -> Result<Scene, SceneError> 
             )),
             "obj" | "ply" => {
                 let file = o.file.as_ref().ok_or_else(|| e("needs `file`".into()))?;
-                let mesh = crate::geometry::mesh_io::load_mesh(
-                    &ctx.base_dir.join(file),
-                    &to_world,
-                    o.flip_normals,
-                )
+                let path = ctx.base_dir.join(file);
+                let mut data = match (o.shape.as_str(), o.flip_tex_coords) {
+                    ("obj", Some(flip)) => crate::geometry::mesh_io::read_obj(&path, flip),
+                    _ => crate::geometry::mesh_io::read_mesh(&path),
+                }
                 .map_err(|x| e(x.to_string()))?;
+                match o.mesh_normals {
+                    MeshNormals::AsStored => {}
+                    MeshNormals::Face => data.normals = None,
+                    MeshNormals::ComputedIfMissing => {
+                        if data.normals.is_none() {
+                            super::mitsuba::vertex_normals::add_vertex_normals(
+                                &mut data, &to_world,
+                            );
+                        }
+                    }
+                }
+                let mesh = data
+                    .into_mesh(&to_world, o.flip_normals)
+                    .map_err(|x| match x {
+                        x @ crate::geometry::GeometryError::InFile { .. } => x,
+                        x => x.in_file(&path, None),
+                    })
+                    .map_err(|x| e(x.to_string()))?;
                 Shape::Mesh(Arc::new(mesh))
             }
             _ => {
@@ -610,7 +650,8 @@ fn build(ctx: &Ctx, desc: SceneDesc, source: &str) -> Result<Scene, SceneError> 
         camera,
         film,
         integrator,
-        source_hash: fnv1a(source.as_bytes()),
+        source_hash,
+        warnings: Vec::new(),
     })
 }
 

@@ -1,10 +1,14 @@
 //! Scenes: the TOML description (`description`), its loading with file:line errors
-//! (`load`), and the built [`Scene`] the integrator renders.
+//! (`load`), Mitsuba 3 XML scenes translated into the same description (`mitsuba`), and
+//! the built [`Scene`] the integrator renders.
 
 pub mod description;
 pub mod load;
+pub mod mitsuba;
 
-pub use load::{load_scene, load_scene_str, SceneError};
+pub use load::{load_scene_str, SceneError};
+
+use std::path::Path;
 
 use crate::camera::Camera;
 use crate::film::Filter;
@@ -48,4 +52,47 @@ pub struct Scene {
     pub integrator: IntegratorSettings,
     /// Hash of the scene source, identifying renders of the same scene.
     pub source_hash: u64,
+    /// What loading accepted but could not honour exactly (Mitsuba parameters that only
+    /// affect quality, such as a sampler type), one line each, for the user to read.
+    pub warnings: Vec<String>,
+}
+
+/// How to load a scene file.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// `name = value` pairs substituted for `$name` in a Mitsuba XML scene (the command
+    /// line's `-D name=value`); they take precedence over the file's `<default>`s.
+    pub defines: Vec<(String, String)>,
+}
+
+/// Loads a scene file: Mitsuba 3 XML for `.xml` (case-insensitive), facette's TOML
+/// format otherwise.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_with(path, &LoadOptions::default())
+}
+
+/// [`load_scene`] with options; `defines` apply to XML scenes only.
+pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, SceneError> {
+    let is_xml = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+    if is_xml {
+        return mitsuba::load_mitsuba_scene(path, &options.defines);
+    }
+    if let Some((name, _)) = options.defines.first() {
+        return Err(SceneError {
+            file: path.to_path_buf(),
+            line: None,
+            message: format!(
+                "`-D {name}=…` applies to Mitsuba XML scenes (.xml) only; this is a TOML scene"
+            ),
+        });
+    }
+    let source = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: path.to_path_buf(),
+        line: None,
+        message: format!("cannot read the scene file: {e}"),
+    })?;
+    load_scene_str(&source, path)
 }
