@@ -268,3 +268,56 @@ impl Bsdf for MultipleScatteringDielectric {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::spherical_direction;
+    use crate::microfacet::{Ggx, Ndf};
+    use crate::validation::chi2::{chi2_test, Chi2Config};
+    use crate::validation::SphereMap;
+
+    #[test]
+    fn facet_scattering_samples_its_phase_function() {
+        let s = Microsurface::new(
+            Ndf::Ggx(Ggx::new(0.7, 0.4).unwrap()),
+            HeightDistribution::Uniform,
+        )
+        .unwrap();
+        let f = DielectricFacets {
+            eta: 1.5,
+            reflect_tint: Spectrum::ONE,
+            transmit_tint: Spectrum::ONE,
+        };
+        let cfg = Chi2Config {
+            samples: 200_000,
+            ..Chi2Config::default()
+        };
+        for inside in [false, true] {
+            for theta in [0.3, 1.2, 1.8, 2.6] {
+                let wi = spherical_direction(theta, 0.7);
+                for crossing in [false, true] {
+                    let out = chi2_test(
+                        &SphereMap::standard(),
+                        &cfg,
+                        |r| {
+                            let m = s.sample_visible(wi, r)?;
+                            let (o, c, _) = f.scatter(wi, m, inside, r)?;
+                            (c == crossing).then_some(o.normalize())
+                        },
+                        |o| f.phase(&s, wi, o, inside, crossing).average(),
+                    );
+                    println!(
+                        "inside {inside} θ {theta} crossing {crossing}: {}",
+                        out.summary()
+                    );
+                    assert!(
+                        out.passes(1e-4),
+                        "inside {inside} θ {theta} crossing {crossing}: {}",
+                        out.summary()
+                    );
+                }
+            }
+        }
+    }
+}
