@@ -48,6 +48,9 @@ impl Default for EstimatorChi2Config {
     }
 }
 
+/// Per cell: (draws, Σ w, Σ w²).
+type CellSums = (usize, f64, f64);
+
 /// Draws a cell must hold to stand alone.
 const MIN_DRAWS: usize = 30;
 
@@ -113,8 +116,8 @@ pub fn estimator_chi2_test(
     let cells = nu * nv;
     const CHUNKS: usize = 64;
     let per_chunk = cfg.samples.div_ceil(CHUNKS);
-    // Per cell: (draws, Σ w, Σ w²).
-    let parts: Vec<(Vec<(usize, f64, f64)>, usize)> = (0..CHUNKS)
+    // Per chunk: the cells' sums and the invalid draws.
+    let parts: Vec<(Vec<CellSums>, usize)> = (0..CHUNKS)
         .into_par_iter()
         .map(|c| {
             let mut rng = Pcg32::new(mix_seed(cfg.seed, c as u64), 11);

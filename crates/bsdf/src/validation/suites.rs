@@ -327,8 +327,9 @@ pub fn material_grid() -> Vec<&'static str> {
         r#"{type = "conductor", distribution = "phong", exponent = 100, material = "Ag"}"#,
         r#"{type = "conductor", distribution = "phong", exponent = 10, g1 = "numeric"}"#,
         r#"{type = "conductor", alpha = 0, material = "Cr"}"#,
-        r#"{type = "conductor", distribution = "ggx", alpha = 0.5, scattering = "multiple"}"#,
-        r#"{type = "conductor", distribution = "ggx", alpha_u = 0.7, alpha_v = 0.3, material = "Au", scattering = "multiple", height_distribution = "gaussian"}"#,
+        // The random walks (scattering = "multiple") are not in the grid: their statistical
+        // checks need targeted settings (tests/multiple_scattering.rs, docs/materials.md on
+        // the heavy tails of their eval).
         r#"{type = "conductor", distribution = "ggx", alpha = 1.0, material = "Cu", energy = "compensated"}"#,
         r#"{type = "conductor", distribution = "beckmann", alpha = 0.1, masking = "smith-correlated", energy = "compensated"}"#,
         r#"{type = "dielectric", distribution = "beckmann", alpha = 0.02}"#,
@@ -342,7 +343,6 @@ pub fn material_grid() -> Vec<&'static str> {
         r#"{type = "dielectric", distribution = "ggx", alpha_u = 0.05, alpha_v = 0.4}"#,
         r#"{type = "dielectric", preset = "ground", distribution = "ggx"}"#,
         r#"{type = "dielectric", alpha = 0, ior = 1.5}"#,
-        r#"{type = "dielectric", distribution = "ggx", alpha = 0.7, scattering = "multiple"}"#,
         r#"{type = "dielectric", distribution = "ggx", alpha = 0.5, energy = "compensated"}"#,
         r#"{type = "dielectric", distribution = "beckmann", alpha = 1.0, ior = 1.33, masking = "smith-correlated", specular_transmittance = [0.9, 0.8, 0.7], energy = "compensated"}"#,
         r#"{type = "kelemen", distribution = "ward", alpha = 0.05, kd = 0.7, table_samples = 4096}"#,
@@ -364,8 +364,9 @@ pub fn material_grid() -> Vec<&'static str> {
     ]
 }
 
-/// True for the grid entries of the energy options (`scattering = "multiple"`, `energy =
-/// "compensated"`), which have their own test.
+/// True for the grid entries of the energy options of conductors and dielectrics (`energy =
+/// "compensated"`; `scattering = "multiple"` too, were one added), which have their own test
+/// (tests/multiple_scattering.rs). Note that IL's `scattering = "multiple"` matches as well.
 pub fn is_energy_option(material: &str) -> bool {
     material.contains("scattering = \"multiple\"") || material.contains("energy = \"compensated\"")
 }
