@@ -412,12 +412,38 @@ fn spectrum_rel_err(x: Spectrum, y: Spectrum) -> f64 {
 }
 
 /// Reciprocity of a stochastic model within Monte Carlo error: converged estimates of
-/// f(a, b) and f(b, a) must agree within 4 combined standard errors.
+/// f(a, b) and f(b, a) must agree within 4 combined standard errors. Some estimators have
+/// heavy tails (the random walk's next-event estimate, docs/materials.md): rare large values
+/// make the sample mean and its standard error both too small for a while. A pair beyond 4
+/// standard errors is therefore re-estimated with 8× and then 64× more estimates, and judged
+/// on the last: a real violation keeps its distance while its error shrinks.
 fn statistical_reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Check {
     let pairs = 40usize;
     let samples = 20_000usize;
     let seed = mix_seed(opts.chi2.seed, 4343);
-    let results: Vec<(f64, f64)> = (0..pairs)
+    // (max z over channels, max relative difference) for a pair at n estimates each way.
+    let compare = |a: Vec3, b: Vec3, n: usize, rng: &mut Pcg32| -> (f64, f64) {
+        let ctx = BsdfContext::RADIANCE;
+        let (fab, sab) = bsdf.eval_estimate(a, b, &ctx, n, rng);
+        let (fba, sba) = bsdf.eval_estimate(b, a, &ctx, n, rng);
+        let mut z: f64 = 0.0;
+        let mut rel: f64 = 0.0;
+        for c in 0..3 {
+            let se = (sab[c] * sab[c] + sba[c] * sba[c]).sqrt();
+            let d = (fab[c] - fba[c]).abs();
+            if se > 0.0 {
+                z = z.max(d / se);
+            } else if d > 1e-12 {
+                z = f64::INFINITY;
+            }
+            let scale = fab[c].abs().max(fba[c].abs());
+            if scale > 1e-10 {
+                rel = rel.max(d / scale);
+            }
+        }
+        (z, rel)
+    };
+    let results: Vec<(f64, f64, usize)> = (0..pairs)
         .into_par_iter()
         .map(|k| {
             let mut rng = Pcg32::new(mix_seed(seed, k as u64), 8);
@@ -426,35 +452,24 @@ fn statistical_reciprocity_check(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Ch
             if a.z * b.z < 0.0 {
                 b.z = -b.z;
             }
-            let ctx = BsdfContext::RADIANCE;
-            let (fab, sab) = bsdf.eval_estimate(a, b, &ctx, samples, &mut rng);
-            let (fba, sba) = bsdf.eval_estimate(b, a, &ctx, samples, &mut rng);
-            let mut z: f64 = 0.0;
-            let mut rel: f64 = 0.0;
-            for c in 0..3 {
-                let se = (sab[c] * sab[c] + sba[c] * sba[c]).sqrt();
-                let d = (fab[c] - fba[c]).abs();
-                if se > 0.0 {
-                    z = z.max(d / se);
-                } else if d > 1e-12 {
-                    z = f64::INFINITY;
-                }
-                let scale = fab[c].abs().max(fba[c].abs());
-                if scale > 1e-10 {
-                    rel = rel.max(d / scale);
-                }
+            let mut n = samples;
+            let (mut z, mut rel) = compare(a, b, n, &mut rng);
+            while z > 4.0 && n < 64 * samples {
+                n *= 8;
+                (z, rel) = compare(a, b, n, &mut rng);
             }
-            (z, rel)
+            (z, rel, n)
         })
         .collect();
     let worst_z = results.iter().map(|r| r.0).fold(0.0, f64::max);
     let worst_rel = results.iter().map(|r| r.1).fold(0.0, f64::max);
+    let escalated = results.iter().filter(|r| r.2 > samples).count();
     // 40 pairs × 3 channels: 4 standard errors keeps the family-wise false alarm below 1 %.
     Check::new(
         bsdf.describe(),
         "reciprocity within Monte Carlo error (stochastic model)",
         format!(
-            "{pairs} pairs × {samples} estimates: max |f(a,b) − f(b,a)| = {worst_z:.2} standard errors (tolerance 4), max relative difference {worst_rel:.1e}"
+            "{pairs} pairs × {samples} estimates ({escalated} re-estimated with up to 64× more): max |f(a,b) − f(b,a)| = {worst_z:.2} standard errors (tolerance 4), max relative difference {worst_rel:.1e}"
         ),
         Verdict::from_bool(worst_z <= 4.0),
     )
