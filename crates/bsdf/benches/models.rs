@@ -38,6 +38,31 @@ const MODELS: &[(&str, &str)] = &[
         "dielectric-beckmann",
         r#"{type = "dielectric", distribution = "beckmann", alpha = 0.3, ior = 1.5}"#,
     ),
+    // The energy options against their single-scattering base (height-correlated masking).
+    (
+        "conductor-ggx-correlated",
+        r#"{type = "conductor", distribution = "ggx", alpha = 0.3, material = "Au", masking = "smith-correlated"}"#,
+    ),
+    (
+        "conductor-ggx-multiple",
+        r#"{type = "conductor", distribution = "ggx", alpha = 0.3, material = "Au", scattering = "multiple"}"#,
+    ),
+    (
+        "conductor-ggx-compensated",
+        r#"{type = "conductor", distribution = "ggx", alpha = 0.3, material = "Au", masking = "smith-correlated", energy = "compensated"}"#,
+    ),
+    (
+        "dielectric-ggx-correlated",
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.3, ior = 1.5, masking = "smith-correlated"}"#,
+    ),
+    (
+        "dielectric-ggx-multiple",
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.3, ior = 1.5, scattering = "multiple"}"#,
+    ),
+    (
+        "dielectric-ggx-compensated",
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.3, ior = 1.5, masking = "smith-correlated", energy = "compensated"}"#,
+    ),
     (
         "kelemen-ward",
         r#"{type = "kelemen", alpha = 0.3, kd = 0.5}"#,
@@ -139,7 +164,7 @@ fn models(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(std::time::Duration::from_millis(300)).measurement_time(std::time::Duration::from_secs(1));
-    targets = models, il_tables
+    targets = models, il_tables, albedo_tables
 }
 criterion_main!(benches);
 
@@ -170,6 +195,25 @@ fn il_tables(c: &mut Criterion) {
                     .unwrap(),
                 )
             })
+        });
+    }
+    g.finish();
+}
+
+/// Building the albedo tables of the energy compensation (GGX, height-correlated masking):
+/// the conductor's (F = 1) and the dielectric's (η = 1.5 and 1/1.5, both sides).
+fn albedo_tables(c: &mut Criterion) {
+    use facette_bsdf::microfacet::{Ggx, Masking, Ndf};
+    use facette_bsdf::models::albedo_tables::{AlbedoTable, TableFresnel};
+    let ndf = Ndf::Ggx(Ggx::isotropic(0.3).unwrap());
+    let mut g = c.benchmark_group("albedo-table-build");
+    g.sample_size(10);
+    for (name, fresnel) in [
+        ("conductor", TableFresnel::One),
+        ("dielectric-1.5", TableFresnel::Dielectric(1.5)),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| black_box(AlbedoTable::build(&ndf, Masking::SmithCorrelated, fresnel)))
         });
     }
     g.finish();

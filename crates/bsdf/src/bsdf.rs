@@ -14,7 +14,11 @@
 //! microfacets) are first-class: every call receives a [`RandomSource`], deterministic
 //! models simply ignore it, and [`Bsdf::is_stochastic`] says which kind a model is. Their
 //! `eval` is an unbiased estimate, their `pdf` is exact, and their `sample` weight is an
-//! unbiased estimate of f·|cos|/pdf.
+//! unbiased estimate of f·|cos|/pdf — except for models that sample by a physical random
+//! walk (the multiple-scattering microsurfaces), whose exit density has no closed form:
+//! [`Bsdf::pdf_is_exact`] is false for them, `pdf` is a documented proxy used only for
+//! multiple importance sampling, and the weight is an unbiased estimate of f·|cos| divided by
+//! the walk's own density (so E[weight · g(wi)] = ∫ f |cos| g for any g).
 
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -46,6 +50,7 @@ impl LobeFlags {
     pub const DIFFUSE_REFLECTION: LobeFlags = LobeFlags(1 | 4);
     pub const GLOSSY_REFLECTION: LobeFlags = LobeFlags(1 | 8);
     pub const GLOSSY_TRANSMISSION: LobeFlags = LobeFlags(2 | 8);
+    pub const DIFFUSE_TRANSMISSION: LobeFlags = LobeFlags(2 | 4);
     pub const DELTA_REFLECTION: LobeFlags = LobeFlags(1 | 16);
     pub const DELTA_TRANSMISSION: LobeFlags = LobeFlags(2 | 16);
 
@@ -114,9 +119,11 @@ impl BsdfContext {
 pub struct BsdfSample {
     /// The sampled direction.
     pub wi: Vec3,
-    /// f·|cos θ_i| / pdf (for delta lobes: the lobe's throughput).
+    /// f·|cos θ_i| / pdf (for delta lobes: the lobe's throughput; for random-walk samplers,
+    /// see [`Bsdf::pdf_is_exact`], f·|cos θ_i| over the walk's own density).
     pub weight: Spectrum,
-    /// Solid-angle density of `wi` (for delta lobes: the lobe-selection probability).
+    /// Solid-angle density of `wi` (for delta lobes: the lobe-selection probability; for
+    /// random-walk samplers, the proxy `pdf(wo, wi)`).
     pub pdf: f64,
     /// The lobe that produced the sample.
     pub lobe: LobeFlags,
@@ -142,8 +149,19 @@ pub trait Bsdf: Send + Sync {
     fn sample(&self, wo: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource)
         -> Option<BsdfSample>;
 
-    /// Solid-angle density with which `sample` produces `wi` (non-delta lobes only).
+    /// Solid-angle density with which `sample` produces `wi` (non-delta lobes only); a proxy
+    /// density when [`Bsdf::pdf_is_exact`] is false.
     fn pdf(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f64;
+
+    /// True when `pdf` is the exact density with which `sample` draws directions. False for
+    /// models that sample by a physical random walk: their `pdf` (which `sample` also
+    /// reports) is a positive proxy density that serves only to weight multiple importance
+    /// sampling — MIS stays unbiased with any such function of the direction, because the
+    /// weights of the two strategies still sum to one — and the validation harness tests
+    /// their sampler against their `eval` instead of against `pdf`.
+    fn pdf_is_exact(&self) -> bool {
+        true
+    }
 
     /// A converged value of f(wo, wi) with its standard error. Deterministic models return
     /// `eval` and zero; stochastic ones average `samples` independent estimates.

@@ -222,6 +222,99 @@ fn validate_material_passes_and_prints_a_summary() {
 }
 
 #[test]
+fn multiple_scattering_and_compensation_restore_the_white_furnace() {
+    // The same spec everywhere: albedo of a white rough conductor, single scattering vs the
+    // random walk vs the compensation; eval of the walk is a stochastic estimate.
+    let albedo = |m: &str| {
+        let o = facette(
+            &[
+                "albedo",
+                "--material",
+                m,
+                "--theta-i",
+                "0",
+                "70",
+                "--samples",
+                "40000",
+            ],
+            None,
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        rows(&o)
+    };
+    let single = albedo(
+        r#"{type = "conductor", distribution = "ggx", alpha = 1, masking = "smith-correlated"}"#,
+    );
+    let multiple =
+        albedo(r#"{type = "conductor", distribution = "ggx", alpha = 1, scattering = "multiple"}"#);
+    let compensated = albedo(
+        r#"{type = "conductor", distribution = "ggx", alpha = 1, masking = "smith-correlated", energy = "compensated"}"#,
+    );
+    for k in 0..2 {
+        assert!(
+            single[k][1] < 0.85,
+            "single scattering loses energy: {:?}",
+            single[k]
+        );
+        assert!((multiple[k][1] - 1.0).abs() < 1e-3, "{:?}", multiple[k]);
+        assert!(
+            (compensated[k][1] - 1.0).abs() < 4.0 * compensated[k][4] + 3e-3,
+            "{:?}",
+            compensated[k]
+        );
+    }
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "dielectric", distribution = "ggx", alpha = 0.7, scattering = "multiple"}"#,
+            "--samples",
+            "20000",
+        ],
+        Some("30,0,40,90\n30,0,150,180\n"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("stochastically"), "{}", stderr(&o));
+    let r = rows(&o);
+    assert!(
+        r.iter().all(|row| row[4] > 0.0 && row[4].is_finite()),
+        "{r:?}"
+    );
+    // Bad values list the valid ones and exit non-zero.
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "conductor", alpha = 1, scattering = "many"}"#,
+        ],
+        Some("30,0,40,90\n"),
+    );
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("single, multiple"), "{}", stderr(&o));
+}
+
+#[test]
+fn validate_material_runs_the_random_walk_checks() {
+    let o = facette(
+        &[
+            "validate",
+            "--material",
+            r#"{type = "conductor", distribution = "ggx", alpha = 0.8, scattering = "multiple"}"#,
+            "--samples",
+            "50000",
+        ],
+        None,
+    );
+    let out = stdout(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(
+        out.contains("random-walk sampler") && out.contains("stochastic model"),
+        "{out}"
+    );
+    assert!(out.lines().last().unwrap().contains(" 0 failed"), "{out}");
+}
+
+#[test]
 fn validate_distribution_and_family() {
     let o = facette(
         &[

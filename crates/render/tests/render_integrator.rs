@@ -32,6 +32,53 @@ fn grey(c: [f64; 3]) -> f64 {
     (c[0] + c[1] + c[2]) / 3.0
 }
 
+/// A rough white conductor (GGX α = 1.5, F = 1) in the furnace: single scattering loses
+/// most of the light; the random walk (scattering = "multiple") and the compensation
+/// (energy = "compensated") render 1 — the rendered form of the issue's white furnace.
+#[test]
+fn rough_white_conductor_furnace_multiple_scattering_and_compensation() {
+    let furnace = |material: &str| {
+        let s = scene(&format!(
+            r#"
+            [camera]
+            position = [0, 0, 3]
+            target = [0, 0, 0]
+            fov = 30
+            [film]
+            width = 24
+            height = 24
+            filter = "box"
+            [[objects]]
+            shape = "sphere"
+            radius = 1
+            material = {material}
+            [[lights]]
+            type = "constant"
+            radiance = 1.0
+            "#
+        ));
+        let film = run(&s, 64, 11, Strategy::Mis, None);
+        let (mean, err) = film.block_mean(0, 0, 24, 24);
+        println!(
+            "furnace {material}: mean {:.4} ± {:.4}",
+            grey(mean),
+            grey(err)
+        );
+        (grey(mean), grey(err))
+    };
+    let (single, _) = furnace(
+        r#"{ type = "conductor", distribution = "ggx", alpha = 1.5, masking = "smith-correlated" }"#,
+    );
+    assert!(single < 0.5, "single scattering loses energy: {single}");
+    for m in [
+        r#"{ type = "conductor", distribution = "ggx", alpha = 1.5, scattering = "multiple" }"#,
+        r#"{ type = "conductor", distribution = "ggx", alpha = 1.5, masking = "smith-correlated", energy = "compensated" }"#,
+    ] {
+        let (mean, err) = furnace(m);
+        assert!((mean - 1.0).abs() < 4.0 * err + 3e-3, "{m}: {mean} ± {err}");
+    }
+}
+
 /// A sphere of white Lambert inside a unit constant environment: every pixel is 1, with
 /// paths long enough that no energy is cut.
 #[test]

@@ -43,6 +43,7 @@ fn example_scenes_render_without_nan_or_inf() {
         "comparison.toml",
         "mesh.toml",
         "bench-sphere.toml",
+        "furnace-ms.toml",
     ] {
         assert!(
             names.iter().any(|n| n == required),

@@ -1,6 +1,12 @@
 //! The BSDF models, one file per model, each built from the shared parts of
-//! [`crate::microfacet`] (one specular lobe, one microfacet integrator).
+//! [`crate::microfacet`] (one specular lobe, one microfacet integrator). The
+//! multiple-scattering conductor and dielectric share the Smith-microsurface random walk of
+//! [`smith_microsurface`]; the compensated ones share the albedo tables of
+//! [`albedo_tables`].
 
+pub mod albedo_tables;
+pub mod compensated_conductor;
+pub mod compensated_dielectric;
 pub(crate) mod cosine_lobe;
 pub mod il_approx;
 pub mod il_approx_coefficients;
@@ -10,14 +16,21 @@ pub mod interfaced_lambertian;
 pub mod kelemen;
 pub mod lambert;
 pub mod microfacet_integral;
+pub mod multiple_scattering_conductor;
+pub mod multiple_scattering_dielectric;
 pub mod oren_nayar;
 pub mod rough_conductor;
 pub mod rough_dielectric;
+pub mod smith_microsurface;
 pub mod vcavity;
 
+pub use compensated_conductor::CompensatedConductor;
+pub use compensated_dielectric::CompensatedDielectric;
 pub use interfaced_lambertian::InterfacedLambertian;
 pub use kelemen::Kelemen;
 pub use lambert::Lambert;
+pub use multiple_scattering_conductor::MultipleScatteringConductor;
+pub use multiple_scattering_dielectric::MultipleScatteringDielectric;
 pub use oren_nayar::{OrenNayarExact, OrenNayarQualitative};
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;

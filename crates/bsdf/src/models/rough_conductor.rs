@@ -43,6 +43,11 @@ impl RoughConductor {
     pub fn fresnel(&self) -> &Fresnel {
         &self.fresnel
     }
+
+    /// The `specular_reflectance` multiplier.
+    pub fn tint(&self) -> Spectrum {
+        self.tint
+    }
 }
 
 impl Bsdf for RoughConductor {

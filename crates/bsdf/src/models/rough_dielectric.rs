@@ -122,6 +122,21 @@ impl RoughDielectric {
         self.eta
     }
 
+    /// `None`: perfectly smooth.
+    pub fn lobe(&self) -> Option<&SpecularLobe> {
+        self.lobe.as_ref()
+    }
+
+    /// The `specular_reflectance` and `specular_transmittance` multipliers.
+    pub fn tints(&self) -> (Spectrum, Spectrum) {
+        (self.reflect_tint, self.transmit_tint)
+    }
+
+    /// True for WMLT07's widened Beckmann sampling.
+    pub fn widened(&self) -> bool {
+        self.widened
+    }
+
     /// (index on the side of w, index on the other side), relative to the outside.
     #[inline]
     fn indices(&self, w: Vec3) -> (f64, f64) {

@@ -16,9 +16,11 @@ use crate::models::interfaced_lambertian::{BodyEvaluation, Scattering};
 use crate::models::kelemen::check_ior;
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::rough_dielectric::{MEASURED_GLASSES, MEASURED_GLASS_IOR};
+use crate::models::smith_microsurface::HeightDistribution;
 use crate::models::{
-    InterfacedLambertian, Kelemen, Lambert, OrenNayarExact, OrenNayarQualitative, RoughConductor,
-    RoughDielectric,
+    CompensatedConductor, CompensatedDielectric, InterfacedLambertian, Kelemen, Lambert,
+    MultipleScatteringConductor, MultipleScatteringDielectric, OrenNayarExact,
+    OrenNayarQualitative, RoughConductor, RoughDielectric,
 };
 use std::sync::Arc;
 
@@ -37,13 +39,25 @@ pub const MATERIAL_TYPES: &[&str] = &[
 /// as unknown, with the valid ones, rather than as a missing required key.
 const LAMBERT_KEYS: &[&str] = &["reflectance"];
 const OREN_NAYAR_KEYS: &[&str] = &["reflectance", "sigma", "model", "evaluation", "samples"];
-const CONDUCTOR_KEYS: &[&str] = &["material", "eta", "k", "fresnel", "specular_reflectance"];
+const CONDUCTOR_KEYS: &[&str] = &[
+    "material",
+    "eta",
+    "k",
+    "fresnel",
+    "specular_reflectance",
+    "scattering",
+    "energy",
+    "height_distribution",
+];
 const DIELECTRIC_KEYS: &[&str] = &[
     "ior",
     "ext_ior",
     "preset",
     "specular_reflectance",
     "specular_transmittance",
+    "scattering",
+    "energy",
+    "height_distribution",
 ];
 const KELEMEN_KEYS: &[&str] = &[
     "distribution",
@@ -87,6 +101,18 @@ pub enum OrenNayarModel {
     L1,
 }
 
+/// What a conductor or dielectric does with the light that meets several microfacets
+/// (`scattering` and `energy` keys).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MicrofacetEnergy {
+    /// Single scattering (WMLT07): that light is lost.
+    Single,
+    /// `scattering = "multiple"`: the random walk on the Smith microsurface (HHdD16).
+    Multiple(HeightDistribution),
+    /// `energy = "compensated"`: the Kulla–Conty compensation lobe (KC17).
+    Compensated,
+}
+
 /// How an interfaced-Lambertian recipe evaluates its body term.
 #[derive(Clone, Debug)]
 pub enum IlEvaluation {
@@ -121,6 +147,7 @@ pub enum MaterialRecipe {
         lobe: Option<SpecularLobe>,
         fresnel: Fresnel,
         tint: Spectrum,
+        energy: MicrofacetEnergy,
     },
     Dielectric {
         lobe: Option<SpecularLobe>,
@@ -128,6 +155,7 @@ pub enum MaterialRecipe {
         widened: bool,
         reflect_tint: Spectrum,
         transmit_tint: Spectrum,
+        energy: MicrofacetEnergy,
     },
     Kelemen(Arc<Kelemen>),
     Il {
@@ -213,20 +241,45 @@ impl MaterialRecipe {
                 lobe,
                 fresnel,
                 tint,
-            } => Arc::new(RoughConductor::new(lobe.clone(), *fresnel, *tint)),
+                energy,
+            } => {
+                let single = RoughConductor::new(lobe.clone(), *fresnel, *tint);
+                // A smooth surface has no inter-reflections: every mode is the mirror.
+                match (energy, lobe) {
+                    (MicrofacetEnergy::Multiple(h), Some(_)) => {
+                        Arc::new(MultipleScatteringConductor::new(single, *h)?)
+                    }
+                    (MicrofacetEnergy::Compensated, Some(_)) => {
+                        Arc::new(CompensatedConductor::new(single)?)
+                    }
+                    _ => Arc::new(single),
+                }
+            }
             MaterialRecipe::Dielectric {
                 lobe,
                 eta,
                 widened,
                 reflect_tint,
                 transmit_tint,
-            } => Arc::new(RoughDielectric::new(
-                *eta,
-                lobe.clone(),
-                *widened,
-                *reflect_tint,
-                *transmit_tint,
-            )?),
+                energy,
+            } => {
+                let single = RoughDielectric::new(
+                    *eta,
+                    lobe.clone(),
+                    *widened,
+                    *reflect_tint,
+                    *transmit_tint,
+                )?;
+                match (energy, lobe) {
+                    (MicrofacetEnergy::Multiple(h), Some(_)) => {
+                        Arc::new(MultipleScatteringDielectric::new(single, *h)?)
+                    }
+                    (MicrofacetEnergy::Compensated, Some(_)) => {
+                        Arc::new(CompensatedDielectric::new(single)?)
+                    }
+                    _ => Arc::new(single),
+                }
+            }
             MaterialRecipe::Kelemen(k) => k.clone(),
             MaterialRecipe::Il {
                 kd,
@@ -502,9 +555,58 @@ fn parse_conductor_fresnel(p: &Params) -> ParamResult<Fresnel> {
     }
 }
 
+/// The `scattering`, `energy` and `height_distribution` keys of conductors and dielectrics.
+fn parse_energy(p: &Params) -> ParamResult<MicrofacetEnergy> {
+    let multiple = match p.str("scattering")?.unwrap_or("single") {
+        "single" => false,
+        "multiple" => true,
+        other => return Err(choice("scattering", other, &["single", "multiple"])),
+    };
+    let compensated = match p.str("energy")?.unwrap_or("uncompensated") {
+        "uncompensated" => false,
+        "compensated" => true,
+        other => return Err(choice("energy", other, &["uncompensated", "compensated"])),
+    };
+    let heights = p.str("height_distribution")?;
+    if heights.is_some() && !multiple {
+        return Err(ParamError::Invalid(
+            "`height_distribution` applies to scattering = \"multiple\"".into(),
+        ));
+    }
+    match (multiple, compensated) {
+        (true, true) => Err(ParamError::Invalid(
+            "energy = \"compensated\" approximates what scattering = \"multiple\" computes: \
+             choose one"
+                .into(),
+        )),
+        (true, false) => Ok(MicrofacetEnergy::Multiple(match heights {
+            Some(h) => HeightDistribution::parse(h)?,
+            None => HeightDistribution::Uniform,
+        })),
+        (false, true) => Ok(MicrofacetEnergy::Compensated),
+        (false, false) => Ok(MicrofacetEnergy::Single),
+    }
+}
+
+/// `masking`, defaulting to the height-correlated Smith form with scattering = "multiple"
+/// (the random walk's first order).
+fn parse_masking_for(
+    p: &Params,
+    ndf: Option<&Ndf>,
+    energy: MicrofacetEnergy,
+) -> ParamResult<crate::microfacet::Masking> {
+    match energy {
+        MicrofacetEnergy::Multiple(_) if !p.has("masking") => {
+            Ok(crate::microfacet::Masking::SmithCorrelated)
+        }
+        _ => parse_masking(p, ndf),
+    }
+}
+
 fn build_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
     let ndf = parse_distribution(p, true)?;
-    let masking = parse_masking(p, ndf.as_ref())?;
+    let energy = parse_energy(p)?;
+    let masking = parse_masking_for(p, ndf.as_ref(), energy)?;
     let sampling = match p.str("sampling")? {
         None => NormalSampling::Visible,
         Some(s) => NormalSampling::parse(s)?,
@@ -521,11 +623,17 @@ fn build_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
         Some(n) => Some(SpecularLobe::new(n, masking, sampling)?),
         None => None,
     };
-    Ok(MaterialRecipe::Conductor {
+    let recipe = MaterialRecipe::Conductor {
         lobe,
         fresnel,
         tint,
-    })
+        energy,
+    };
+    if energy != MicrofacetEnergy::Single {
+        // Reports unsupported combinations now (and builds the shared tables once).
+        recipe.build()?;
+    }
+    Ok(recipe)
 }
 
 fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
@@ -574,7 +682,8 @@ fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
         100.0,
         Bounds::OpenClosed,
     )?;
-    let masking = parse_masking(p, ndf.as_ref())?;
+    let energy = parse_energy(p)?;
+    let masking = parse_masking_for(p, ndf.as_ref(), energy)?;
     let (sampling, widened) = match p.str("sampling")?.unwrap_or("visible") {
         "widened" => (NormalSampling::Distribution, true),
         s => (
@@ -607,6 +716,7 @@ fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
         widened,
         reflect_tint: rt,
         transmit_tint: tt,
+        energy,
     };
     recipe.build()?;
     Ok(recipe)

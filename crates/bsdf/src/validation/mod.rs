@@ -8,6 +8,7 @@
 pub mod bsdf_checks;
 pub mod chi2;
 pub mod distribution_checks;
+pub mod estimator_chi2;
 pub mod measurements;
 pub mod sphere_map;
 pub mod suites;
