@@ -1,6 +1,7 @@
 //! The BSDF models, one file per model, each built from the shared parts of
 //! [`crate::microfacet`] (one specular lobe, one microfacet integrator).
 
+pub mod glint;
 pub mod il_approx;
 pub mod il_approx_coefficients;
 pub mod il_table;
