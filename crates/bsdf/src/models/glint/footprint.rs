@@ -69,15 +69,19 @@ impl Footprint {
 
     /// Finite, positive semi-definite covariance.
     pub fn sanitized(self) -> Footprint {
-        let ok = self.center.is_finite() && self.cov.iter().all(|v| v.is_finite());
-        if !ok {
-            return Footprint::isotropic(Vec2::ZERO, 0.0);
+        let center = if self.center.is_finite() {
+            self.center
+        } else {
+            Vec2::ZERO
+        };
+        if !self.cov.iter().all(|v| v.is_finite()) {
+            return Footprint::isotropic(center, 0.0);
         }
         let xx = self.cov[0].max(0.0);
         let yy = self.cov[2].max(0.0);
         let lim = (xx * yy).sqrt();
         Footprint {
-            center: self.center,
+            center,
             cov: [xx, self.cov[1].clamp(-lim, lim), yy],
         }
     }

@@ -9,7 +9,7 @@
 //! | `scratched` | flat plate with 0.4·H straight grooves (random direction, length 5–45 % of the map, half-width 0.7–1.6 texel, parabolic profile, depth 0.15–0.6 × half-width), deepest groove wins; analytic gradient | ≈ 0.1 |
 //! | `brushed` | white noise filtered with a Gaussian of σ = 48 texels along x and 0.7 texel along y, scaled to an RMS y-slope of 0.15 | ≈ (0.003, 0.15) |
 //! | `bumpy` | white noise filtered with an isotropic Gaussian of σ = 3 texels, scaled to an RMS slope of 0.45 per axis ("very rough") | ≈ 0.45 |
-//! | `flakes` | periodic Voronoi cells on a jittered grid of 6-texel spacing; each cell a flat flake with a Gaussian random slope (σ = 0.15 per axis, ≈ 8.5°) | ≈ 0.15 |
+//! | `flakes` | periodic Voronoi cells on a jittered grid of 6-texel spacing; each cell a flat flake with a Gaussian random slope (σ = 0.15 per axis, ≈ 8.5°), minus the map's mean slope | ≈ 0.15 |
 //!
 //! Heights are in texel units, so the slope of a texel is the height gradient.
 
@@ -253,7 +253,7 @@ fn flakes(n: usize, seed: u64) -> Vec<[f32; 2]> {
             (p, [(0.15 * gx) as f32, (0.15 * gy) as f32])
         })
         .collect();
-    (0..n * n)
+    let slopes: Vec<[f32; 2]> = (0..n * n)
         .into_par_iter()
         .with_min_len(4096)
         .map(|k| {
@@ -277,6 +277,16 @@ fn flakes(n: usize, seed: u64) -> Vec<[f32; 2]> {
             }
             best.1
         })
+        .collect();
+    // Zero mean slope, as for any periodic height field: a non-zero mean would tilt the
+    // whole plate, and a tilted patch seen with the renderer's cos θ_i is not energy
+    // conserving (docs/glints.md).
+    let count = (n * n) as f64;
+    let mx = slopes.iter().map(|s| s[0] as f64).sum::<f64>() / count;
+    let my = slopes.iter().map(|s| s[1] as f64).sum::<f64>() / count;
+    slopes
+        .iter()
+        .map(|s| [(s[0] as f64 - mx) as f32, (s[1] as f64 - my) as f32])
         .collect()
 }
 

@@ -97,14 +97,18 @@ impl GlintBsdf {
         self.masking.visible_projected_area(v)
     }
 
-    /// f_P without the reflectance multiplier's colour, for an upper-hemisphere pair.
+    /// f_P for an upper-hemisphere pair.
     fn eval_upper(&self, o: Vec3, i: Vec3) -> Spectrum {
         let h = (o + i).normalize_or_zero();
         let cos_oh = o.dot(h);
         if !(h.z > 0.0) || !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
             return Spectrum::ZERO;
         }
-        let d = self.ndf().d(h);
+        self.eval_with_d(o, i, cos_oh, self.ndf().d(h))
+    }
+
+    /// f_P given D_P(h) (the sampler has it already: one P-NDF query per sample).
+    fn eval_with_d(&self, o: Vec3, i: Vec3, cos_oh: f64, d: f64) -> Spectrum {
         if !(d > 0.0) {
             return Spectrum::ZERO;
         }
@@ -151,11 +155,16 @@ impl Bsdf for GlintBsdf {
         }
         // The pdf is evaluated at the half vector of (o, i), exactly as `pdf` will.
         let h = (o + i).normalize();
-        let pdf = ndf.pdf_normal(h) / (4.0 * o.dot(h));
+        let cos_oh = o.dot(h);
+        if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
+            return None;
+        }
+        let d = ndf.d(h);
+        let pdf = d * h.z.max(0.0) / (4.0 * cos_oh);
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
-        let f = self.eval_upper(o, i);
+        let f = self.eval_with_d(o, i, cos_oh, d);
         let weight = f * (i.z / pdf);
         if !weight.is_finite() {
             return None;

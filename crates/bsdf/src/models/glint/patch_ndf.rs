@@ -104,14 +104,17 @@ impl<'a> PatchNdf<'a> {
                         },
                         |x, y| {
                             touched += 1;
-                            let p = surf.lobes[y * w + x].p22(sf);
-                            if p == 0.0 {
+                            // Both truncation tests first, then one exponential for the
+                            // product P22_i · e^{−m/2} (the hot loop of every query).
+                            let lobe = &surf.lobes[y * w + x];
+                            let ql = lobe.mahalanobis2(sf);
+                            if !(ql <= CUTOFF_R2 as f32) {
                                 return;
                             }
                             let u = Vec2::new(ox + x as f64 + 0.5, oy + y as f64 + 0.5);
                             let m = q.mahalanobis2(u);
                             if m <= CUTOFF_R2 {
-                                sum += p * (-0.5 * m).exp();
+                                sum += lobe.peak() * (-0.5 * (ql as f64 + m)).exp();
                             }
                         },
                     );
