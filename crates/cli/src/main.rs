@@ -4,6 +4,7 @@
 mod cmd_albedo;
 mod cmd_eval;
 mod cmd_il_approx;
+mod cmd_normalmap;
 mod cmd_render;
 mod cmd_tabulate;
 mod cmd_validate;
@@ -41,6 +42,8 @@ enum Command {
     Tabulate(cmd_tabulate::TabulateArgs),
     /// Fit or measure the approximate interfaced-Lambertian body term (IL18 §4.2).
     IlApprox(cmd_il_approx::IlApproxArgs),
+    /// Normal maps for the glint material (CCM19): generate the kinds of CCM19 Fig. 7.
+    Normalmap(cmd_normalmap::NormalMapArgs),
 }
 
 fn main() -> ExitCode {
@@ -52,6 +55,7 @@ fn main() -> ExitCode {
         Command::Validate(a) => cmd_validate::run(a),
         Command::Tabulate(a) => cmd_tabulate::run(a),
         Command::IlApprox(a) => cmd_il_approx::run(a),
+        Command::Normalmap(a) => cmd_normalmap::run(a),
     };
     match result {
         Ok(code) => code,
