@@ -303,7 +303,10 @@ fn albedos(bsdf: &GlintBsdf, wo: Vec3, n: usize, seed: u64) -> ([f64; 2], [f64; 
             }
             a
         })
-        .reduce(|| [0.0; 4], |x, y| [x[0] + y[0], x[1] + y[1], x[2] + y[2], x[3] + y[3]]);
+        .reduce(
+            || [0.0; 4],
+            |x, y| [x[0] + y[0], x[1] + y[1], x[2] + y[2], x[3] + y[3]],
+        );
     let m = (per * CHUNKS) as f64;
     let stats = |s: f64, s2: f64| {
         let mean = s / m;
@@ -336,7 +339,11 @@ fn energy_is_bounded_and_the_cosine_question_is_measured() {
             );
             let mean = bsdf.masking().filtered_lobe().mean;
             // Large footprints cost ~ their area per query: normal incidence only.
-            let angles: &[f64] = if sigma >= 12.0 { &[0.0] } else { &[0.0, 45.0, 80.0] };
+            let angles: &[f64] = if sigma >= 12.0 {
+                &[0.0]
+            } else {
+                &[0.0, 45.0, 80.0]
+            };
             for &deg in angles {
                 let wo = spherical_direction(deg.to_radians(), 0.3);
                 let t0 = std::time::Instant::now();

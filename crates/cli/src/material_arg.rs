@@ -32,7 +32,8 @@ pub fn parse_material_at(text: &str, footprint: Option<&str>) -> Result<Arc<dyn 
         if table.get("type").and_then(|t| t.as_str()) != Some("glint") {
             bail!("--footprint applies to `type = \"glint\"` materials only");
         }
-        let arr = |xs: &[f64]| toml::Value::Array(xs.iter().map(|x| toml::Value::Float(*x)).collect());
+        let arr =
+            |xs: &[f64]| toml::Value::Array(xs.iter().map(|x| toml::Value::Float(*x)).collect());
         table.insert("footprint_center".into(), arr(&v[..2]));
         let size = match v.len() {
             3 => vec![v[2]],

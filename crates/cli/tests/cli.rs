@@ -530,16 +530,40 @@ fn normalmap_generate_writes_every_kind_and_eval_reads_them_with_a_footprint() {
         assert!(o.status.success(), "{kind}: {}", stderr(&o));
         let r = rows(&o);
         assert_eq!(r.len(), 2);
-        assert!(r.iter().all(|row| row[4..].iter().all(|v| v.is_finite() && *v >= 0.0)));
+        assert!(r
+            .iter()
+            .all(|row| row[4..].iter().all(|v| v.is_finite() && *v >= 0.0)));
         assert!(r[0][4] > 0.0, "{kind}: {r:?}");
     }
     for (args, msg) in [
-        (vec!["normalmap", "generate", "wood", "-o", "x.png"], "scratched, brushed, bumpy, flakes"),
         (
-            vec!["normalmap", "generate", "bumpy", "-o", "x.png", "--resolution", "5000"],
+            vec!["normalmap", "generate", "wood", "-o", "x.png"],
+            "scratched, brushed, bumpy, flakes",
+        ),
+        (
+            vec![
+                "normalmap",
+                "generate",
+                "bumpy",
+                "-o",
+                "x.png",
+                "--resolution",
+                "5000",
+            ],
             "4096",
         ),
-        (vec!["normalmap", "generate", "bumpy", "-o", "x.jpg", "--resolution", "8"], ".png or .exr"),
+        (
+            vec![
+                "normalmap",
+                "generate",
+                "bumpy",
+                "-o",
+                "x.jpg",
+                "--resolution",
+                "8",
+            ],
+            ".png or .exr",
+        ),
     ] {
         let o = facette(&args, None);
         assert!(!o.status.success());
@@ -560,9 +584,15 @@ fn bad_normal_maps_are_clear_errors() {
     std::fs::write(&junk, b"definitely not a png").unwrap();
     for (file, msg) in [
         (grey.display().to_string(), "greyscale"),
-        (zeros.display().to_string(), "do not decode to a unit normal"),
+        (
+            zeros.display().to_string(),
+            "do not decode to a unit normal",
+        ),
         (junk.display().to_string(), "junk.png"),
-        (dir.path().join("none.exr").display().to_string(), "none.exr"),
+        (
+            dir.path().join("none.exr").display().to_string(),
+            "none.exr",
+        ),
     ] {
         let mat = format!(r#"{{type = "glint", normal_map = "{file}"}}"#);
         let o = facette(&["eval", "--material", &mat], Some("10,0,10,180\n"));
@@ -578,7 +608,11 @@ fn image_png(path: &std::path::Path, px: &[[u8; 3]; 16]) {
         for &b in data {
             c ^= b as u32;
             for _ in 0..8 {
-                c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
+                c = if c & 1 != 0 {
+                    0xedb8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
             }
         }
         !c

@@ -161,7 +161,11 @@ impl SceneMaterial {
             return Some(MaterialBsdf::Shared(f.as_ref()));
         }
         if self.textures.is_empty() {
-            return self.recipe.build_at(uv, derivs).ok().map(MaterialBsdf::Textured);
+            return self
+                .recipe
+                .build_at(uv, derivs)
+                .ok()
+                .map(MaterialBsdf::Textured);
         }
         let mut r = self.recipe.clone();
         for t in &self.textures {

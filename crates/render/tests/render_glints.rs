@@ -73,7 +73,10 @@ fn white_furnace_of_a_very_rough_orb() {
             grey(err),
             1.0 - grey(mean)
         );
-        assert!(grey(mean) <= 1.0 + 4.0 * grey(err), "{masking}: {mean:?} ± {err:?}");
+        assert!(
+            grey(mean) <= 1.0 + 4.0 * grey(err),
+            "{masking}: {mean:?} ± {err:?}"
+        );
         assert!(grey(mean) > 0.5, "{masking}: {mean:?}");
     }
 }

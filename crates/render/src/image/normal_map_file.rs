@@ -33,8 +33,8 @@ pub struct ImageNormalMapReader;
 
 impl NormalMapReader for ImageNormalMapReader {
     fn read(&self, path: &Path) -> Result<DecodedImage, String> {
-        let img = read_image(path, ColorEncoding::Linear)
-            .map_err(|e| format!("normal map: {e}"))?;
+        let img =
+            read_image(path, ColorEncoding::Linear).map_err(|e| format!("normal map: {e}"))?;
         Ok(DecodedImage {
             width: img.width(),
             height: img.height(),
