@@ -114,6 +114,8 @@ pub fn seed_moments(map: &NormalMap, x: i64, y: i64) -> ([f64; 2], [f64; 3]) {
             let (mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0);
             for a in 0usize..5 {
                 let p = s[b][a];
+                // a2 indexes the banded weight matrix and the row of slopes together.
+                #[allow(clippy::needless_range_loop)]
                 for a2 in a.saturating_sub(1)..(a + 2).min(5) {
                     let ka = w.quad[a][a2];
                     let q = s[b2][a2];
