@@ -6,7 +6,7 @@
 //! starts a comment. Output rows `theta_i,phi_i,theta_o,phi_o,r,g,b` with f(i, o) without
 //! the cosine factor (delta lobes excluded).
 
-use crate::material_arg::parse_material;
+use crate::material_arg::parse_material_at;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use facette_bsdf::math::rng::Pcg32;
@@ -40,6 +40,10 @@ pub struct EvalArgs {
     /// Seed of the stochastic estimates.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Glints: the ray footprint, U,V,SIGMA[,SIGMA_V[,RHO]] (uv centre; standard deviations
+    /// in texels; correlation).
+    #[arg(long, value_name = "U,V,SIGMA")]
+    footprint: Option<String>,
 }
 
 /// Parses one data row; `Ok(None)` for blank lines, comments and a header.
@@ -83,7 +87,7 @@ pub fn parse_row(line: &str, lineno: usize, source: &str) -> Result<Option<[f64;
 }
 
 pub fn run(a: EvalArgs) -> Result<ExitCode> {
-    let bsdf = parse_material(&a.material)?;
+    let bsdf = parse_material_at(&a.material, a.footprint.as_deref())?;
     if a.samples == 0 {
         bail!("--samples must be at least 1");
     }

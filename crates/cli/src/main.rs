@@ -7,6 +7,7 @@ mod cmd_fit;
 mod cmd_il_approx;
 mod cmd_measure;
 mod cmd_merge;
+mod cmd_normalmap;
 mod cmd_plot;
 mod cmd_render;
 mod cmd_reproduce;
@@ -56,6 +57,8 @@ enum Command {
     Measure(cmd_measure::MeasureArgs),
     /// Regenerate the papers' figures (SVG and PNG) and print their key numbers.
     Reproduce(cmd_reproduce::ReproduceArgs),
+    /// Normal maps for the glint material (CCM19): generate the kinds of CCM19 Fig. 7.
+    Normalmap(cmd_normalmap::NormalMapArgs),
 }
 
 /// Output piped into a reader that stops early (`facette eval … | head`) is not an error:
@@ -92,6 +95,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => cmd_fit::run(a),
         Command::Measure(a) => cmd_measure::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
+        Command::Normalmap(a) => cmd_normalmap::run(a),
     };
     match result {
         Ok(code) => code,

@@ -1,11 +1,47 @@
-//! Parsing of `--material` (a TOML inline table) shared by the subcommands.
+//! Parsing of `--material` (a TOML inline table) shared by the subcommands. Image files a
+//! material names (a glint `normal_map`) are read relative to the working directory.
 
-use anyhow::{Context, Result};
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use anyhow::{bail, Context, Result};
+use facette_bsdf::spec::{build_material_with_reader, parse_inline_table};
 use facette_bsdf::Bsdf;
+use facette_render::image::ImageNormalMapReader;
 use std::sync::Arc;
 
 pub fn parse_material(text: &str) -> Result<Arc<dyn Bsdf>> {
-    let table = parse_inline_table(text).context("--material")?;
-    build_material(&table).context("--material")
+    parse_material_at(text, None)
+}
+
+/// Parses `--material`, with `--footprint U,V,SIGMA[,SIGMA_V[,RHO]]` (uv centre, standard
+/// deviations in texels, correlation) for glints: it sets the material's
+/// `footprint_center` and `footprint_size` keys [CCM19 §4.1].
+pub fn parse_material_at(text: &str, footprint: Option<&str>) -> Result<Arc<dyn Bsdf>> {
+    let mut table = parse_inline_table(text).context("--material")?;
+    if let Some(fp) = footprint {
+        let v: Vec<f64> = fp
+            .split(',')
+            .map(|s| s.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .ok()
+            .filter(|v: &Vec<f64>| (3..=5).contains(&v.len()) && v.iter().all(|x| x.is_finite()))
+            .with_context(|| {
+                format!(
+                    "--footprint `{fp}`: expected U,V,SIGMA[,SIGMA_V[,RHO]] (uv centre, standard \
+                     deviations in texels, correlation in (-1, 1))"
+                )
+            })?;
+        if table.get("type").and_then(|t| t.as_str()) != Some("glint") {
+            bail!("--footprint applies to `type = \"glint\"` materials only");
+        }
+        let arr =
+            |xs: &[f64]| toml::Value::Array(xs.iter().map(|x| toml::Value::Float(*x)).collect());
+        table.insert("footprint_center".into(), arr(&v[..2]));
+        let size = match v.len() {
+            3 => vec![v[2]],
+            4 => vec![v[2], v[3]],
+            _ => vec![v[2], v[3], v[4]],
+        };
+        table.insert("footprint_size".into(), arr(&size));
+    }
+    build_material_with_reader(&table, std::path::Path::new("."), &ImageNormalMapReader)
+        .context("--material")
 }

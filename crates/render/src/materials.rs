@@ -14,7 +14,7 @@
 //! Colour images are decoded from sRGB by default; roughness images are read linearly by
 //! default (`encoding` overrides). A roughness texture's value is its channel average.
 
-use crate::image::{read_image, ColorEncoding, MipMap, Texture, WrapMode};
+use crate::image::{read_image, ColorEncoding, ImageNormalMapReader, MipMap, Texture, WrapMode};
 use facette_bsdf::spec::MaterialRecipe;
 use facette_bsdf::{Bsdf, Spectrum};
 use glam::DVec2;
@@ -74,8 +74,12 @@ impl SceneMaterial {
             }
         }
         // Scalars were replaced by triples above; turn roughness keys back into numbers.
-        let mut recipe = MaterialRecipe::parse(&scalarize(&plain, &pending), base_dir)
-            .map_err(|e| e.to_string())?;
+        let mut recipe = MaterialRecipe::parse_with_reader(
+            &scalarize(&plain, &pending),
+            base_dir,
+            Some(&ImageNormalMapReader),
+        )
+        .map_err(|e| e.to_string())?;
         let mut textures = Vec::new();
         for (key, texture, (lo, hi)) in pending {
             let spectrum_keys = recipe.texturable_spectrum_keys();
@@ -118,11 +122,10 @@ impl SceneMaterial {
                 ));
             }
         }
-        let fixed = if textures.is_empty() {
-            Some(recipe.build().map_err(|e| e.to_string())?)
-        } else {
-            None
-        };
+        // Glints depend on each hit's footprint: built per shading point. Build one now
+        // anyway so that a material that cannot be built fails at load time.
+        let built = recipe.build().map_err(|e| e.to_string())?;
+        let fixed = (textures.is_empty() && !recipe.varies_per_hit()).then_some(built);
         Ok(SceneMaterial {
             name: name.to_string(),
             recipe,
@@ -133,7 +136,8 @@ impl SceneMaterial {
 
     /// A material from an already built BSDF (tests, programmatic scenes).
     pub fn from_recipe(name: &str, recipe: MaterialRecipe) -> Result<SceneMaterial, String> {
-        let fixed = Some(recipe.build().map_err(|e| e.to_string())?);
+        let built = recipe.build().map_err(|e| e.to_string())?;
+        let fixed = (!recipe.varies_per_hit()).then_some(built);
         Ok(SceneMaterial {
             name: name.into(),
             recipe,
@@ -146,13 +150,22 @@ impl SceneMaterial {
         !self.textures.is_empty()
     }
 
-    /// The BSDF at a shading point with texture coordinates `uv` and footprint `derivs`:
-    /// the shared one for an untextured material (borrowed: no reference-count traffic
-    /// between threads), a freshly built one otherwise.
+    /// The BSDF at a shading point with texture coordinates `uv` and footprint `derivs`
+    /// (`[du/dx, dv/dx, du/dy, dv/dy]`, zeros when unknown): the shared one for an
+    /// untextured material (borrowed: no reference-count traffic between threads), a
+    /// freshly built one otherwise. Glints [CCM19] take their ray footprint from `uv` and
+    /// `derivs` here.
     #[inline]
     pub fn bsdf(&self, uv: DVec2, derivs: [f64; 4]) -> Option<MaterialBsdf<'_>> {
         if let Some(f) = &self.fixed {
             return Some(MaterialBsdf::Shared(f.as_ref()));
+        }
+        if self.textures.is_empty() {
+            return self
+                .recipe
+                .build_at(uv, derivs)
+                .ok()
+                .map(MaterialBsdf::Textured);
         }
         let mut r = self.recipe.clone();
         for t in &self.textures {
@@ -167,7 +180,7 @@ impl SceneMaterial {
                 return None;
             }
         }
-        r.build().ok().map(MaterialBsdf::Textured)
+        r.build_at(uv, derivs).ok().map(MaterialBsdf::Textured)
     }
 }
 

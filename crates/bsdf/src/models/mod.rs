@@ -8,6 +8,7 @@ pub mod albedo_tables;
 pub mod compensated_conductor;
 pub mod compensated_dielectric;
 pub(crate) mod cosine_lobe;
+pub mod glint;
 pub mod il_approx;
 pub mod il_approx_coefficients;
 pub mod il_table;

@@ -1,6 +1,7 @@
 //! Building a BSDF from a material table: `type` selects the model, the other keys are its
 //! parameters (documented per model and in `docs/materials.md`).
 
+use super::glint::{parse_glint, GlintRecipe, NormalMapReader, GLINT_KEYS};
 use super::microfacet::{parse_distribution, parse_masking, MICROFACET_KEYS};
 use super::params::{check_spectrum, Params};
 use crate::bsdf::Bsdf;
@@ -32,6 +33,7 @@ pub const MATERIAL_TYPES: &[&str] = &[
     "dielectric",
     "kelemen",
     "il",
+    "glint",
 ];
 
 /// The keys of each material type besides `type` (and the microfacet keys where the type
@@ -91,6 +93,16 @@ pub fn build_material_in(
     base_dir: &std::path::Path,
 ) -> ParamResult<Arc<dyn Bsdf>> {
     MaterialRecipe::parse(table, base_dir)?.build()
+}
+
+/// Builds the BSDF described by `table`, reading image files (a glint `normal_map`) with
+/// `reader`; relative paths are resolved against `base_dir`.
+pub fn build_material_with_reader(
+    table: &toml::Table,
+    base_dir: &std::path::Path,
+    reader: &dyn NormalMapReader,
+) -> ParamResult<Arc<dyn Bsdf>> {
+    MaterialRecipe::parse_with_reader(table, base_dir, Some(reader))?.build()
 }
 
 /// Oren–Nayar variants.
@@ -165,11 +177,24 @@ pub enum MaterialRecipe {
         evaluation: IlEvaluation,
         scattering: Scattering,
     },
+    /// Glints [CCM19]: its BSDF depends on the footprint of each shading point
+    /// ([`MaterialRecipe::build_at`]).
+    Glint(GlintRecipe),
 }
 
 impl MaterialRecipe {
-    /// Parses and validates a material table.
+    /// Parses and validates a material table (without an image reader: a glint
+    /// `normal_map` file is an error, see [`MaterialRecipe::parse_with_reader`]).
     pub fn parse(table: &toml::Table, base_dir: &std::path::Path) -> ParamResult<MaterialRecipe> {
+        Self::parse_with_reader(table, base_dir, None)
+    }
+
+    /// Parses and validates a material table, reading image files with `reader`.
+    pub fn parse_with_reader(
+        table: &toml::Table,
+        base_dir: &std::path::Path,
+        reader: Option<&dyn NormalMapReader>,
+    ) -> ParamResult<MaterialRecipe> {
         let ty = match table.get("type") {
             Some(toml::Value::String(s)) => s.as_str(),
             Some(_) => return Err(ParamError::Invalid("`type` must be a string".into())),
@@ -189,6 +214,7 @@ impl MaterialRecipe {
             "dielectric" => Some(keys(DIELECTRIC_KEYS, true)),
             "kelemen" => Some(keys(KELEMEN_KEYS, false)),
             "il" | "interfaced-lambertian" => Some(keys(IL_KEYS, true)),
+            "glint" => Some(keys(GLINT_KEYS, false)),
             _ => None,
         };
         if let Some(known) = known {
@@ -206,6 +232,11 @@ impl MaterialRecipe {
             "dielectric" => build_dielectric(&p),
             "kelemen" => build_kelemen(&p),
             "il" | "interfaced-lambertian" => build_il(&p, base_dir),
+            "glint" => {
+                let g = parse_glint(&p, base_dir, reader)?;
+                p.finish(&keys(GLINT_KEYS, false))?;
+                Ok(MaterialRecipe::Glint(g))
+            }
             other => Err(ParamError::UnknownChoice {
                 what: "material type".into(),
                 given: other.into(),
@@ -307,7 +338,24 @@ impl MaterialRecipe {
                     *scattering,
                 )?)
             }
+            MaterialRecipe::Glint(g) => g.build_default(),
         })
+    }
+
+    /// True when the BSDF depends on the shading point's footprint (glints): the renderer
+    /// must build it per hit with [`MaterialRecipe::build_at`].
+    pub fn varies_per_hit(&self) -> bool {
+        matches!(self, MaterialRecipe::Glint(_))
+    }
+
+    /// Builds the BSDF of a shading point with texture coordinates `uv` and screen-space
+    /// derivatives `[du/dx, dv/dx, du/dy, dv/dy]` (all zero when unknown). Only glints use
+    /// them; every other material is [`MaterialRecipe::build`].
+    pub fn build_at(&self, uv: crate::math::Vec2, derivs: [f64; 4]) -> ParamResult<Arc<dyn Bsdf>> {
+        match self {
+            MaterialRecipe::Glint(g) => Ok(g.build_at(uv, derivs)),
+            _ => self.build(),
+        }
     }
 
     /// Spectrum-valued keys a texture may drive.
@@ -319,6 +367,7 @@ impl MaterialRecipe {
                 &["specular_reflectance", "specular_transmittance"]
             }
             MaterialRecipe::Kelemen(_) | MaterialRecipe::Il { .. } => &["kd"],
+            MaterialRecipe::Glint(_) => &["specular_reflectance"],
         }
     }
 
@@ -389,6 +438,7 @@ impl MaterialRecipe {
                 "kd",
             ) => *reflectance = v,
             (MaterialRecipe::Kelemen(k), "kd") => *k = Arc::new(k.with_kd(v)?),
+            (MaterialRecipe::Glint(g), "specular_reflectance") => g.params.tint = v,
             _ => return Err(bad()),
         }
         Ok(())
@@ -514,7 +564,7 @@ fn build_oren_nayar(p: &Params) -> ParamResult<MaterialRecipe> {
 }
 
 /// The conductor's Fresnel term from `material`, `eta`/`k` and `fresnel`.
-fn parse_conductor_fresnel(p: &Params) -> ParamResult<Fresnel> {
+pub(super) fn parse_conductor_fresnel(p: &Params) -> ParamResult<Fresnel> {
     let preset = p.str("material")?;
     let eta = p.spectrum("eta")?;
     let k = p.spectrum("k")?;

@@ -2,11 +2,15 @@
 //! line (`--material '{type = "dielectric", alpha = 0.3}'`) and the scene files. Every key
 //! is validated; unknown keys and values are errors that list the valid ones.
 
+pub mod glint;
 pub mod material;
 pub mod microfacet;
 pub mod params;
 
-pub use material::{build_material, build_material_in, MaterialRecipe, MATERIAL_TYPES};
+pub use glint::{DecodedImage, GlintRecipe, NormalMapReader};
+pub use material::{
+    build_material, build_material_in, build_material_with_reader, MaterialRecipe, MATERIAL_TYPES,
+};
 pub use params::Params;
 
 use crate::error::ParamError;

@@ -125,6 +125,26 @@ impl<'a> Params<'a> {
         }
     }
 
+    /// One number or an array of numbers (integers accepted).
+    pub fn numbers(&self, key: &str) -> ParamResult<Option<Vec<f64>>> {
+        let num = |v: &toml::Value| match v {
+            toml::Value::Float(f) => Some(*f),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        };
+        match self.take(key) {
+            None => Ok(None),
+            Some(toml::Value::Array(a)) => a
+                .iter()
+                .map(|v| num(v).ok_or_else(|| self.wrong(key, "numbers", v)))
+                .collect::<ParamResult<Vec<f64>>>()
+                .map(Some),
+            Some(v) => num(v)
+                .map(|x| Some(vec![x]))
+                .ok_or_else(|| self.wrong(key, "a number or an array of numbers", v)),
+        }
+    }
+
     /// Errors on any key not read so far, listing `valid`.
     /// Fails on the first key of the table that is not in `valid` (before any is read).
     pub fn check_known(&self, valid: &[&str]) -> ParamResult<()> {

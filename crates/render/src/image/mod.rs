@@ -11,6 +11,7 @@
 //!   importance-sampled by luminance; [`ConstantEnvironment`] for uniform radiance; both
 //!   sample into an [`EnvSample`].
 //! - [`Distribution2D`]: the piecewise-constant 2-D distribution behind the sampling.
+//! - [`normal_map_file`]: normal maps for glints (PNG 8/16-bit, EXR in; 16-bit PNG, EXR out).
 //! - [`sky`]: the procedural sky ([`SkyParams`], [`generate_sky`], [`ensure_sky`]).
 
 // `!(x > 0.0)` is used on purpose, as in facette-bsdf: it is true for NaN, which must be
@@ -25,6 +26,7 @@ pub mod error;
 mod exr_file;
 pub mod io;
 pub mod mipmap;
+pub mod normal_map_file;
 pub mod rgb_image;
 pub mod sky;
 pub mod srgb;
@@ -37,6 +39,7 @@ pub use error::ImageError;
 pub use exr_file::{read_exr_channels, write_exr_channels, ExrChannels};
 pub use io::{read_image, write_image, ColorEncoding};
 pub use mipmap::{MipMap, WrapMode};
+pub use normal_map_file::{write_normal_map, ImageNormalMapReader};
 pub use rgb_image::RgbImage;
 pub use sky::{ensure_sky, generate_sky, load_or_generate_sky, SkyParams};
 pub use texture::Texture;

@@ -1,0 +1,379 @@
+//! Patch masking and projected area  [CCM19 §4.2, eqs. 10–17], exact and approximate.
+//!
+//! Everything reduces to the patch's visible projected area
+//! I_P(v) = ∫ ⟨v, m⟩ D_P(m) dω_m = Σ_i W_i I_i(v) / Σ_i W_i  [CCM19 eq. 12], with I_i the
+//! closed form of [`super::lobe`]:
+//!
+//! - projected area A_P(v) = Σ W_i (v_z − v_⊥·μ_i)⁺ / Σ W_i  [CCM19 eq. 17];
+//! - Λ_P(v) = (I_P(v) − A_P(v)) / A_P(v)  [CCM19 eq. 15] and G1_dist = 1/(1 + Λ_P) =
+//!   A_P/I_P  [CCM19 eqs. 11, 14];
+//! - G2 = χ⁺(h·o) χ⁺(h·i) G1_dist(o) G1_dist(i)  [CCM19 eqs. 10, 16].
+//!
+//! In the P-BRDF (eq. 7) the projected areas cancel: F G2 D_P / (4 A_P(o) A_P(i)) =
+//! F χ⁺χ⁺ D_P / (4 I_P(o) I_P(i)). The BSDF therefore only needs I_P, which also keeps it
+//! defined where a footprint's mean facet faces away from a direction (A_P = 0, Λ_P = ∞).
+//!
+//! **Exact** (`masking = "exact"`): the sum over the footprint's seeds T (the same
+//! truncation as the patch NDF). Its cost grows with the footprint's area, so above a
+//! budget of seeds (`masking_lobes`, default [`DEFAULT_MASKING_LOBES`]; 0 = unlimited) the
+//! sum is taken over the blocks of the coarsest-needed mip level instead, each block a
+//! moment-matched lobe weighted by its area — exact at level 0, an approximation beyond
+//! (measured in the tests and docs/glints.md).
+//!
+//! **Approximate** (`masking = "approx"`, §4.2.2): one Beckmann lobe whose mean, standard
+//! deviations and correlation are the W-weighted moments of the footprint, read from the
+//! mip level at which the footprint spans at most [`APPROX_BLOCKS`] texels; its Λ and
+//! projected area give G1 and A_P. Computed once per footprint, so a query costs one erfc.
+//!
+//! Block weights at level l: area · N(centre; c, Σ_P + v_l I) with v_l = σ_k² + (4^l − 1)/12,
+//! the second moment of the seed weights summed over a 2^l × 2^l block (σ_k² at level 0,
+//! where the weights are exactly the W_i).
+
+use super::footprint::{FootprintQuery, Weighting};
+use super::lobe::{expected_positive_part, LobeF64, CUTOFF_R2};
+use super::microsurface::SEED_SIGMA;
+use super::mip_levels::{block_extent, Moments};
+use super::surface::GlintSurface;
+use crate::error::{ParamError, ParamResult};
+use crate::math::{Vec2, Vec3, PI};
+
+/// Default budget of lobes summed by the exact masking term.
+pub const DEFAULT_MASKING_LOBES: usize = 1024;
+
+/// Blocks (at most) averaged into the approximate term's single lobe.
+pub const APPROX_BLOCKS: f64 = 16.0;
+
+/// Which masking-shadowing and projected area the P-BRDF uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaskingMode {
+    /// CCM19 eqs. 13–17 summed over the footprint's lobes.
+    Exact,
+    /// CCM19 §4.2.2: one mip-filtered lobe.
+    Approx,
+}
+
+impl MaskingMode {
+    pub const NAMES: &'static [&'static str] = &["exact", "approx"];
+
+    pub fn parse(s: &str) -> ParamResult<Self> {
+        match s {
+            "exact" => Ok(MaskingMode::Exact),
+            "approx" | "approximate" => Ok(MaskingMode::Approx),
+            other => Err(ParamError::UnknownChoice {
+                what: "glint masking".into(),
+                given: other.into(),
+                valid: Self::NAMES.join(", "),
+            }),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MaskingMode::Exact => "exact",
+            MaskingMode::Approx => "approx",
+        }
+    }
+}
+
+/// Variance of the summed seed weights of a level-l block (per axis).
+#[inline]
+fn level_variance(l: usize) -> f64 {
+    let side = (1u64 << l) as f64;
+    SEED_SIGMA * SEED_SIGMA + (side * side - 1.0) / 12.0
+}
+
+/// Estimated number of level-l blocks in the footprint's truncation ellipse.
+fn blocks_estimate(surface: &GlintSurface, query: &FootprintQuery, l: usize) -> f64 {
+    match query.weighting {
+        Weighting::Uniform => {
+            let (w, h) = surface.pyramid.level_size(l);
+            (w * h) as f64
+        }
+        Weighting::Gaussian => {
+            let s = level_covariance(query, l);
+            let area = PI * CUTOFF_R2 * (s[0] * s[2] - s[1] * s[1]).max(0.0).sqrt();
+            area / ((1u64 << (2 * l)) as f64) + 1.0
+        }
+    }
+}
+
+/// Σ_P + v_l I, from the query's S = Σ_P + σ_k² I.
+fn level_covariance(query: &FootprintQuery, l: usize) -> [f64; 3] {
+    let extra = level_variance(l) - SEED_SIGMA * SEED_SIGMA;
+    [query.s[0] + extra, query.s[1], query.s[2] + extra]
+}
+
+/// The finest level whose block count in the footprint is at most `budget` (0: level 0).
+pub fn choose_level(surface: &GlintSurface, query: &FootprintQuery, budget: f64) -> usize {
+    let top = surface.pyramid.levels() - 1;
+    if budget <= 0.0 {
+        return 0;
+    }
+    (0..=top)
+        .find(|&l| blocks_estimate(surface, query, l) <= budget)
+        .unwrap_or(top)
+}
+
+/// Calls `f(moments, weight)` for every block of level `l` in the footprint (unnormalized
+/// weights; see the module notes).
+pub fn for_each_block(
+    surface: &GlintSurface,
+    query: &FootprintQuery,
+    l: usize,
+    mut f: impl FnMut(Moments, f64),
+) {
+    let (w, h) = (surface.width(), surface.height());
+    let (lw, lh) = surface.pyramid.level_size(l);
+    let lobes = surface.lobes();
+    if query.weighting == Weighting::Uniform {
+        for by in 0..lh {
+            let (y0, y1) = block_extent(h, l, by);
+            for bx in 0..lw {
+                let (x0, x1) = block_extent(w, l, bx);
+                let area = ((x1 - x0) * (y1 - y0)) as f64;
+                f(surface.pyramid.moments(lobes, l, bx, by), area);
+            }
+        }
+        return;
+    }
+    let s = level_covariance(query, l);
+    let det = (s[0] * s[2] - s[1] * s[1]).max(1e-300);
+    let inv = [s[2] / det, -s[1] / det, s[0] / det];
+    let e = FootprintQuery::ellipse_half_extent(s);
+    let c = query.center;
+    let (wf, hf) = (w as f64, h as f64);
+    for (tx, ty) in query.tiles_reached(s, inv) {
+        let (ox, oy) = (tx as f64 * wf, ty as f64 * hf);
+        let range = |lo: f64, hi: f64, n: usize, nb: usize| -> (usize, usize) {
+            let a = lo.max(0.0);
+            let b = hi.min(n as f64 - 1e-9);
+            if b < a {
+                return (1, 0);
+            }
+            (
+                ((a as usize) >> l).min(nb - 1),
+                ((b as usize) >> l).min(nb - 1),
+            )
+        };
+        let (bx0, bx1) = range(c.x - e.x - ox, c.x + e.x - ox, w, lw);
+        let (by0, by1) = range(c.y - e.y - oy, c.y + e.y - oy, h, lh);
+        if bx1 < bx0 || by1 < by0 {
+            continue;
+        }
+        for by in by0..=by1 {
+            let (y0, y1) = block_extent(h, l, by);
+            let cy = oy + 0.5 * (y0 + y1) as f64;
+            for bx in bx0..=bx1 {
+                let (x0, x1) = block_extent(w, l, bx);
+                let d = Vec2::new(ox + 0.5 * (x0 + x1) as f64, cy) - c;
+                let q = inv[0] * d.x * d.x + 2.0 * inv[1] * d.x * d.y + inv[2] * d.y * d.y;
+                if q > CUTOFF_R2 {
+                    continue;
+                }
+                let area = ((x1 - x0) * (y1 - y0)) as f64;
+                f(
+                    surface.pyramid.moments(lobes, l, bx, by),
+                    area * (-0.5 * q).exp(),
+                );
+            }
+        }
+    }
+}
+
+/// A lobe with its normalized weight, flattened for the inner loop: mean x, mean y, Σxx,
+/// Σxy, Σyy, weight.
+type WeightedLobe = [f64; 6];
+
+/// The masking term of one footprint.
+#[derive(Clone, Debug)]
+pub struct PatchMasking {
+    mode: MaskingMode,
+    lobes: Vec<WeightedLobe>,
+    level: usize,
+}
+
+impl PatchMasking {
+    /// CCM19 eqs. 13–17 over the footprint's lobes (module notes on `budget`).
+    pub fn exact(surface: &GlintSurface, query: &FootprintQuery, budget: usize) -> Self {
+        let level = choose_level(surface, query, budget as f64);
+        let mut lobes = Vec::new();
+        let mut total = 0.0;
+        for_each_block(surface, query, level, |m, w| {
+            let l = m.lobe();
+            lobes.push([l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], w]);
+            total += w;
+        });
+        normalize(&mut lobes, total);
+        PatchMasking {
+            mode: MaskingMode::Exact,
+            lobes,
+            level,
+        }
+    }
+
+    /// CCM19 §4.2.2: the single W-weighted, moment-matched lobe.
+    pub fn approx(surface: &GlintSurface, query: &FootprintQuery) -> Self {
+        let level = choose_level(surface, query, APPROX_BLOCKS);
+        let mut acc = Moments::default();
+        let mut total = 0.0;
+        for_each_block(surface, query, level, |m, w| {
+            acc.add_scaled(&m, w);
+            total += w;
+        });
+        let m = if total > 0.0 {
+            acc.scaled(1.0 / total)
+        } else {
+            Moments {
+                mean: [0.0; 2],
+                second: [1e-4, 0.0, 1e-4],
+            }
+        };
+        let l = m.lobe();
+        PatchMasking {
+            mode: MaskingMode::Approx,
+            lobes: vec![[l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], 1.0]],
+            level,
+        }
+    }
+
+    pub fn new(
+        mode: MaskingMode,
+        surface: &GlintSurface,
+        query: &FootprintQuery,
+        budget: usize,
+    ) -> Self {
+        match mode {
+            MaskingMode::Exact => Self::exact(surface, query, budget),
+            MaskingMode::Approx => Self::approx(surface, query),
+        }
+    }
+
+    pub fn mode(&self) -> MaskingMode {
+        self.mode
+    }
+
+    /// The mip level the sum runs over (0: the lobes themselves).
+    pub fn level(&self) -> usize {
+        self.level
+    }
+
+    /// Number of lobes summed per query.
+    pub fn lobe_count(&self) -> usize {
+        self.lobes.len()
+    }
+
+    /// The footprint's moment-matched lobe (mean and covariance of P22_P).
+    pub fn filtered_lobe(&self) -> LobeF64 {
+        let mut m = Moments::default();
+        for e in &self.lobes {
+            let lm = Moments {
+                mean: [e[0], e[1]],
+                second: [e[2] + e[0] * e[0], e[3] + e[0] * e[1], e[4] + e[1] * e[1]],
+            };
+            m.add_scaled(&lm, e[5]);
+        }
+        m.lobe()
+    }
+
+    /// I_P(v) = ∫ ⟨v, m⟩ D_P(m) dω_m  [CCM19 eq. 12 denominator] (exact), or the single
+    /// lobe's A(1 + Λ) (approximate). `v` in the upper hemisphere.
+    #[inline]
+    pub fn visible_projected_area(&self, v: Vec3) -> f64 {
+        let mut sum = 0.0;
+        for e in &self.lobes {
+            let d = v.z - v.x * e[0] - v.y * e[1];
+            let s2 = v.x * v.x * e[2] + 2.0 * v.x * v.y * e[3] + v.y * v.y * e[4];
+            sum += e[5] * expected_positive_part(d, s2.max(0.0).sqrt());
+        }
+        sum
+    }
+
+    /// A_P(v)  [CCM19 eq. 17] (approximate: from the filtered mean slope).
+    pub fn projected_area(&self, v: Vec3) -> f64 {
+        self.lobes
+            .iter()
+            .map(|e| e[5] * (v.z - v.x * e[0] - v.y * e[1]).max(0.0))
+            .sum()
+    }
+
+    /// Λ_P(v)  [CCM19 eq. 15]; ∞ when A_P = 0.
+    pub fn lambda(&self, v: Vec3) -> f64 {
+        let a = self.projected_area(v);
+        if a <= 0.0 {
+            return f64::INFINITY;
+        }
+        (self.visible_projected_area(v) - a).max(0.0) / a
+    }
+
+    /// G1_dist(v) = 1/(1 + Λ_P(v))  [CCM19 eq. 14].
+    pub fn g1_distant(&self, v: Vec3) -> f64 {
+        let i = self.visible_projected_area(v);
+        if i <= 0.0 {
+            return 0.0;
+        }
+        (self.projected_area(v) / i).min(1.0)
+    }
+}
+
+fn normalize(lobes: &mut [WeightedLobe], total: f64) {
+    if total > 0.0 {
+        for e in lobes.iter_mut() {
+            e[5] /= total;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::glint::footprint::Footprint;
+    use crate::models::glint::generate::{generate, NormalMapKind};
+
+    #[test]
+    fn a_flat_map_has_beckmann_masking() {
+        let map =
+            super::super::normal_map::NormalMap::from_slopes(8, 8, vec![[0.0, 0.0]; 64]).unwrap();
+        let surf = GlintSurface::build(map, 0.2, "flat").unwrap();
+        let q = FootprintQuery::new(Footprint::isotropic(Vec2::new(4.0, 4.0), 2.0), 8, 8);
+        let b = crate::microfacet::Beckmann::isotropic(0.2 * std::f64::consts::SQRT_2).unwrap();
+        for mode in [MaskingMode::Exact, MaskingMode::Approx] {
+            let m = PatchMasking::new(mode, &surf, &q, DEFAULT_MASKING_LOBES);
+            for t in [0.0, 0.5, 1.0, 1.4, 1.55] {
+                let v = crate::math::spherical_direction(t, 0.3);
+                let l = crate::microfacet::Distribution::lambda(&b, v);
+                assert!((m.lambda(v) - l).abs() < 1e-5 * (1.0 + l), "{mode:?} {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn exact_level_zero_sums_the_footprint_lobes() {
+        let map = generate(NormalMapKind::Bumpy, 32, 1).unwrap();
+        let surf = GlintSurface::build(map, 0.01, "b").unwrap();
+        let q = FootprintQuery::new(Footprint::isotropic(Vec2::new(7.0, 30.0), 1.5), 32, 32);
+        let m = PatchMasking::exact(&surf, &q, 0);
+        assert_eq!(m.level(), 0);
+        // Direct sum over every seed of every tile.
+        let v = crate::math::spherical_direction(1.2, 0.4);
+        let (mut num, mut den) = (0.0, 0.0);
+        for ty in -2..=2i64 {
+            for tx in -2..=2i64 {
+                for y in 0..32 {
+                    for x in 0..32 {
+                        let u = Vec2::new((tx * 32 + x) as f64 + 0.5, (ty * 32 + y) as f64 + 0.5);
+                        let d = q.mahalanobis2(u);
+                        if d > CUTOFF_R2 {
+                            continue;
+                        }
+                        let w = (-0.5 * d).exp();
+                        let l = surf.lobes()[(y * 32 + x) as usize].to_f64();
+                        num += w * l.visible_projected_area(v);
+                        den += w;
+                    }
+                }
+            }
+        }
+        let i = m.visible_projected_area(v);
+        assert!((i - num / den).abs() < 1e-12, "{i} {}", num / den);
+    }
+}
