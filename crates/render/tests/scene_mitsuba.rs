@@ -1002,3 +1002,40 @@ fn the_example_scenes_render_without_nan() {
         .to_string()
         .contains("missing.xml"));
 }
+
+/// facette's glint material as a Mitsuba plugin: parameters named as in TOML, a normal map
+/// file resolved next to the scene, and its keys listed when one is wrong.
+#[test]
+fn glint_plugin_renders_from_a_generated_map_or_a_file() {
+    let sphere = |bsdf: &str| {
+        scene_xml(&format!(
+            r#"<shape type="sphere">{bsdf}</shape>
+    <emitter type="point"><point name="position" x="0" y="2" z="4"/><rgb name="intensity" value="40"/></emitter>"#
+        ))
+    };
+    let s = load(&sphere(
+        r#"<bsdf type="glint"><string name="generate" value="bumpy"/><integer name="resolution" value="32"/><float name="uv_scale" value="2"/><string name="material" value="Al"/></bsdf>"#,
+    ));
+    let mean = render_image(&s, 2).mean();
+    assert!(mean[0] > 0.0 && mean.is_finite(), "{mean:?}");
+
+    let dir = tempfile::tempdir().unwrap();
+    // A flat 2×2 tangent-space normal map (every normal (0, 0, 1)).
+    let mut img = image::RgbImage::new(2, 2);
+    for p in img.pixels_mut() {
+        *p = image::Rgb([128, 128, 255]);
+    }
+    img.save(dir.path().join("flat.png")).unwrap();
+    let s = load_in(
+        dir.path(),
+        &sphere(r#"<bsdf type="glint"><string name="normal_map" value="flat.png"/></bsdf>"#),
+        &[],
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(render_image(&s, 1).mean().is_finite());
+
+    let e = error(&sphere(
+        r#"<bsdf type="glint"><string name="generate" value="bumpy"/><float name="roughnes" value="0.1"/></bsdf>"#,
+    ));
+    assert!(e.contains("roughnes") && e.contains("scene.xml:"), "{e}");
+}
