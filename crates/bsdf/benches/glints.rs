@@ -1,6 +1,6 @@
 //! Benchmarks of the glint model [CCM19] on generated 2048² maps: the cost of one P-NDF
-//! query against the footprint size, the build of the lobe mixture (lobes + slope hierarchy
-//! + moment pyramid), and eval/sample of the P-BRDF with exact and approximate masking.
+//! query against the footprint size, the build of the lobe mixture (lobes, slope hierarchy
+//! and moment pyramid), and eval/sample of the P-BRDF with exact and approximate masking.
 //! Also prints the memory per texel of each part. Results are in docs/performance.md.
 //!
 //!   cargo bench -p facette-bsdf --bench glints -- --warm-up-time 1 --measurement-time 3
@@ -78,6 +78,8 @@ fn pndf_query(c: &mut Criterion) {
         let surf = surface(kind);
         let mut g = c.benchmark_group(format!("pndf-query-{name}-{SIZE}"));
         g.throughput(Throughput::Elements(256));
+        // σ = 64 visits ~10⁵ lobes per query: 10 samples keep the run to seconds.
+        g.sample_size(10);
         for sigma in SIGMAS {
             let queries: Vec<FootprintQuery> = centres()
                 .into_iter()
