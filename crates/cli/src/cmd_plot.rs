@@ -1,9 +1,9 @@
 //! `facette plot`: BSDF figures (SVG or PNG by the output's extension) — incidence-plane
-//! slices, polar lobes, hemisphere maps, directional albedo, and an IL body table against
+//! slices, polar lobes, hemisphere maps, a glint footprint's patch NDF, directional albedo, and an IL body table against
 //! its quadrature (TSBRM Fig. 10). Prints one summary line per curve; `--csv` writes the
 //! plotted numbers.
 
-use crate::material_arg::parse_material;
+use crate::material_arg::{parse_glint_at, parse_material};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use facette_bsdf::models::il_table::BodyTable;
@@ -15,8 +15,9 @@ use facette_lab::plot::bsdf_charts::{
     LabelledBsdf, SliceOptions,
 };
 use facette_lab::plot::bsdf_data::{Channel, Quantity, Side};
+use facette_lab::plot::ndf_map::patch_ndf_map;
 use facette_lab::plot::table_comparison::compare_table;
-use facette_lab::plot::{save_figure, Format, LineChart, Scale};
+use facette_lab::plot::{save_figure, Format, HemisphereMap, LineChart, Scale};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -97,6 +98,34 @@ enum PlotKind {
         /// Cells across the disk.
         #[arg(long, default_value_t = 96)]
         resolution: usize,
+    },
+    /// Glints: false-colour map of the patch NDF D_P(ω_h) of one footprint over the
+    /// projected disk of half vectors [CCM19 eq. 9]; each cell averages D_P over
+    /// SUPERSAMPLE² points.
+    Ndf {
+        /// A `type = "glint"` material as a TOML inline table.
+        #[arg(long, value_name = "TOML")]
+        material: String,
+        /// The footprint, U,V,SIGMA[,SIGMA_V[,RHO]] (uv centre; standard deviations in
+        /// texels; correlation), as for `facette eval` (default: the material's
+        /// `footprint_center` and `footprint_size`).
+        #[arg(long, value_name = "U,V,SIGMA")]
+        footprint: Option<String>,
+        /// Logarithmic colour scale.
+        #[arg(long)]
+        log: bool,
+        /// Cells across the disk.
+        #[arg(long, default_value_t = 128)]
+        resolution: usize,
+        /// Points per cell side averaged for each cell (the lobes are narrower than a cell).
+        #[arg(long, default_value_t = 4)]
+        supersample: usize,
+        /// Output figure (.svg or .png).
+        #[arg(short, long, value_name = "FILE")]
+        output: PathBuf,
+        /// Also write the cell values as CSV (x,y,value).
+        #[arg(long, value_name = "FILE")]
+        csv: Option<PathBuf>,
     },
     /// Directional reflectance (and transmittance) against θ_i.
     Albedo {
@@ -217,6 +246,24 @@ fn finish(chart: &LineChart, output: &Path, csv: &Option<PathBuf>) -> Result<()>
     Ok(())
 }
 
+/// Writes a hemisphere map and, with `--csv`, its cell values.
+fn save_map(map: &HemisphereMap, output: &Path, csv: &Option<PathBuf>) -> Result<()> {
+    save_figure(map, output)?;
+    if let Some(p) = csv {
+        let mut s = String::from("x,y,value\n");
+        for (k, v) in map.values.iter().enumerate() {
+            if let Some(v) = v {
+                let (x, y) = HemisphereMap::cell_centre(map.n, k);
+                s += &format!("{x:.6},{y:.6},{v:.9e}\n");
+            }
+        }
+        facette_lab::atomic_file::write_atomically(p, s.as_bytes())
+            .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    println!("wrote {}", output.display());
+    Ok(())
+}
+
 pub fn run(a: PlotArgs) -> Result<ExitCode> {
     match a.kind {
         PlotKind::Slice(s) => {
@@ -276,19 +323,41 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
                 (a.min(v), b.max(v))
             });
             println!("hemisphere map, θ_i = {theta_i}°: min {lo:.6e}, max {hi:.6e}");
-            save_figure(&map, &m.output)?;
-            if let Some(p) = &m.csv {
-                let mut s = String::from("x,y,value\n");
-                for (k, v) in map.values.iter().enumerate() {
-                    if let Some(v) = v {
-                        let (x, y) = facette_lab::plot::HemisphereMap::cell_centre(map.n, k);
-                        s += &format!("{x:.6},{y:.6},{v:.9e}\n");
-                    }
-                }
-                facette_lab::atomic_file::write_atomically(p, s.as_bytes())
-                    .with_context(|| format!("cannot write {}", p.display()))?;
+            save_map(&map, &m.output, &m.csv)?;
+        }
+        PlotKind::Ndf {
+            material,
+            footprint,
+            log,
+            resolution,
+            supersample,
+            output,
+            csv,
+        } => {
+            if !(8..=512).contains(&resolution) {
+                bail!("--resolution {resolution}: expected 8…512 cells");
             }
-            println!("wrote {}", m.output.display());
+            if !(1..=16).contains(&supersample) {
+                bail!("--supersample {supersample}: expected 1…16 points per cell side");
+            }
+            Format::of(&output)?;
+            let bsdf = parse_glint_at(&material, footprint.as_deref())?;
+            let fp = bsdf.query();
+            let title = format!(
+                "D_P of {} — footprint centre ({:.1}, {:.1}) texels",
+                bsdf.surface().label(),
+                fp.center.x,
+                fp.center.y
+            );
+            let mut m = patch_ndf_map(&bsdf, title, resolution, supersample);
+            m.map.scale = if log { Scale::Log } else { Scale::Linear };
+            m.map.value_range()?;
+            println!("{}", facette_bsdf::Bsdf::describe(&bsdf));
+            println!(
+                "patch NDF map ({resolution}² cells, {supersample}² points each): max {:.6e} 1/sr, ∫ D_P cos θ_h dω_h ≈ {:.4}",
+                m.max, m.integral
+            );
+            save_map(&m.map, &output, &csv)?;
         }
         PlotKind::Albedo { m, step } => {
             if !(0.5..=45.0).contains(&step) {

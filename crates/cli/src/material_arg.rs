@@ -2,8 +2,9 @@
 //! material names (a glint `normal_map`) are read relative to the working directory.
 
 use anyhow::{bail, Context, Result};
-use facette_bsdf::spec::{build_material_with_reader, parse_inline_table};
-use facette_bsdf::Bsdf;
+use facette_bsdf::models::glint::GlintBsdf;
+use facette_bsdf::spec::{build_material_with_reader, parse_inline_table, MaterialRecipe};
+use facette_bsdf::{Bsdf, Vec2};
 use facette_render::image::ImageNormalMapReader;
 use std::sync::Arc;
 
@@ -15,6 +16,40 @@ pub fn parse_material(text: &str) -> Result<Arc<dyn Bsdf>> {
 /// deviations in texels, correlation) for glints: it sets the material's
 /// `footprint_center` and `footprint_size` keys [CCM19 §4.1].
 pub fn parse_material_at(text: &str, footprint: Option<&str>) -> Result<Arc<dyn Bsdf>> {
+    let table = material_table(text, footprint)?;
+    build_material_with_reader(&table, std::path::Path::new("."), &ImageNormalMapReader)
+        .context("--material")
+}
+
+/// Parses a glint `--material` (with an optional `--footprint`) into the concrete P-BRDF of
+/// that footprint; any other material type is an error that says which one it got.
+pub fn parse_glint_at(text: &str, footprint: Option<&str>) -> Result<GlintBsdf> {
+    let ty = parse_inline_table(text)
+        .context("--material")?
+        .get("type")
+        .and_then(|t| t.as_str().map(str::to_string));
+    if ty.as_deref() != Some("glint") {
+        bail!(
+            "--material: a patch NDF needs a `type = \"glint\"` material, got {}",
+            ty.map_or("no type".to_string(), |t| format!("`type = \"{t}\"`"))
+        );
+    }
+    let table = material_table(text, footprint)?;
+    let recipe = MaterialRecipe::parse_with_reader(
+        &table,
+        std::path::Path::new("."),
+        Some(&ImageNormalMapReader),
+    )
+    .context("--material")?;
+    let MaterialRecipe::Glint(g) = recipe else {
+        bail!("--material: a patch NDF needs a `type = \"glint\"` material");
+    };
+    Ok(g.bsdf_at(Vec2::from(g.footprint_center), [0.0; 4]))
+}
+
+/// The `--material` table with `--footprint` applied as `footprint_center` and
+/// `footprint_size`.
+fn material_table(text: &str, footprint: Option<&str>) -> Result<toml::Table> {
     let mut table = parse_inline_table(text).context("--material")?;
     if let Some(fp) = footprint {
         let v: Vec<f64> = fp
@@ -42,6 +77,5 @@ pub fn parse_material_at(text: &str, footprint: Option<&str>) -> Result<Arc<dyn 
         };
         table.insert("footprint_size".into(), arr(&size));
     }
-    build_material_with_reader(&table, std::path::Path::new("."), &ImageNormalMapReader)
-        .context("--material")
+    Ok(table)
 }

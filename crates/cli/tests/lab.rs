@@ -556,3 +556,86 @@ mod reproduce {
         );
     }
 }
+
+#[test]
+fn plot_ndf_of_a_glint_footprint() {
+    let d = tmp();
+    // A small bumpy map with a wide roughness floor: 8 × 8 points per cell resolve every
+    // lobe, so the cell averages integrate to ∫ D_P cos θ_h dω_h = 1.
+    let mat = r#"{type = "glint", generate = "bumpy", resolution = 64, seed = 2, roughness_floor = 0.05}"#;
+    let (png, csv) = (d.path().join("ndf.png"), d.path().join("ndf.csv"));
+    let o = facette(&[
+        "plot",
+        "ndf",
+        "--material",
+        mat,
+        "--footprint",
+        "0.3,0.6,4,2,0.2",
+        "--resolution",
+        "64",
+        "--supersample",
+        "8",
+        "-o",
+        s(&png),
+        "--csv",
+        s(&csv),
+    ]);
+    ok(&o);
+    assert!(is_png(&png));
+    let out = stdout(&o);
+    let integral: f64 = out
+        .split("dω_h ≈ ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!((integral - 1.0).abs() < 0.02, "{out}");
+    // The CSV has the cells inside the disk, all finite and non-negative, some positive.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let vals: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(vals.len() > 3000 && vals.len() < 64 * 64, "{}", vals.len());
+    assert!(vals.iter().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(vals.iter().any(|v| *v > 1.0));
+    // SVG output, the material's own footprint.
+    let svg = d.path().join("ndf.svg");
+    let o = facette(&[
+        "plot",
+        "ndf",
+        "--material",
+        mat,
+        "--resolution",
+        "16",
+        "--log",
+        "-o",
+        s(&svg),
+    ]);
+    ok(&o);
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("sin θ_h"));
+    // Clear errors: a material without a patch NDF, a malformed footprint.
+    for (args, msg) in [
+        (
+            vec!["--material", CONDUCTOR],
+            "needs a `type = \"glint\"` material, got `type = \"conductor\"`",
+        ),
+        (
+            vec!["--material", mat, "--footprint", "0.5,0.5"],
+            "expected U,V,SIGMA[,SIGMA_V[,RHO]]",
+        ),
+        (
+            vec!["--material", mat, "--footprint", "0.5,0.5,2,2,1.5"],
+            "ρ",
+        ),
+    ] {
+        let bad = d.path().join("bad.png");
+        let mut a = vec!["plot", "ndf", "-o", s(&bad)];
+        a.extend(args);
+        let o = facette(&a);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(msg), "{msg}: {}", stderr(&o));
+        assert!(!bad.exists());
+    }
+}

@@ -21,6 +21,8 @@ pub struct HemisphereMap {
     pub scale: Scale,
     /// Points to mark (x, y on the disk) with labels.
     pub markers: Vec<((f64, f64), String)>,
+    /// Axis titles: the direction the disk shows (ω_o by default; ω_h for an NDF).
+    pub axes: [String; 2],
     pub size: (u32, u32),
 }
 
@@ -47,6 +49,10 @@ impl HemisphereMap {
             values,
             scale: Scale::Linear,
             markers: Vec::new(),
+            axes: [
+                "x = sin θ_o cos φ_o".to_string(),
+                "y = sin θ_o sin φ_o".to_string(),
+            ],
             size: (720, 600),
         }
     }
@@ -134,8 +140,8 @@ impl Figure for HemisphereMap {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("x = sin θ_o cos φ_o")
-            .y_desc("y = sin θ_o sin φ_o")
+            .x_desc(self.axes[0].as_str())
+            .y_desc(self.axes[1].as_str())
             .axis_desc_style(("sans-serif", 15))
             .label_style(("sans-serif", 12))
             .x_label_formatter(&|v: &f64| fmt_tick(if v.abs() < 1e-9 { 0.0 } else { *v }))

@@ -1,0 +1,234 @@
+//! Benchmarks of the glint model [CCM19] on generated 2048² maps: the cost of one P-NDF
+//! query against the footprint size, the build of the lobe mixture (lobes, slope hierarchy
+//! and moment pyramid), and eval/sample of the P-BRDF with exact and approximate masking.
+//! Also prints the memory per texel of each part. Results are in docs/performance.md.
+//!
+//!   cargo bench -p facette-bsdf --bench glints -- --warm-up-time 1 --measurement-time 3
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
+use facette_bsdf::fresnel::Fresnel;
+use facette_bsdf::math::rng::Pcg32;
+use facette_bsdf::math::spectrum::Spectrum;
+use facette_bsdf::math::spherical_direction;
+use facette_bsdf::models::glint::footprint::FootprintQuery;
+use facette_bsdf::models::glint::hierarchy::SlopeHierarchy;
+use facette_bsdf::models::glint::microsurface::{build_lobes, DEFAULT_ROUGHNESS_FLOOR};
+use facette_bsdf::models::glint::patch_masking::DEFAULT_MASKING_LOBES;
+use facette_bsdf::models::glint::patch_ndf::PatchNdf;
+use facette_bsdf::models::glint::{
+    generate, Footprint, GlintBsdf, GlintParams, GlintSurface, MaskingMode, NormalMapKind,
+};
+use facette_bsdf::{Bsdf, BsdfContext, Vec2, Vec3};
+use std::sync::{Arc, OnceLock};
+
+const SIZE: usize = 2048;
+const SIGMAS: [f64; 4] = [1.0, 4.0, 16.0, 64.0];
+const KINDS: [(&str, NormalMapKind); 2] = [
+    ("scratched", NormalMapKind::Scratched),
+    ("bumpy", NormalMapKind::Bumpy),
+];
+
+/// The 2048² surfaces, built once for every benchmark.
+fn surface(kind: usize) -> Arc<GlintSurface> {
+    static S: OnceLock<Vec<Arc<GlintSurface>>> = OnceLock::new();
+    S.get_or_init(|| {
+        KINDS
+            .iter()
+            .map(|(name, k)| {
+                let map = generate(*k, SIZE, 3).unwrap();
+                let s =
+                    GlintSurface::build(map, DEFAULT_ROUGHNESS_FLOOR, format!("{name} {SIZE}²"))
+                        .unwrap();
+                println!(
+                    "{name} {SIZE}²: built in {:.2} s (lobes + hierarchy + mip levels)",
+                    s.build_seconds()
+                );
+                for l in s.memory().lines() {
+                    println!("  {l}");
+                }
+                println!(
+                    "  one lobe: {} bytes (std::mem::size_of)",
+                    std::mem::size_of_val(&s.lobes()[0])
+                );
+                Arc::new(s)
+            })
+            .collect()
+    })[kind]
+        .clone()
+}
+
+/// 64 footprint centres spread over the map (texels).
+fn centres() -> Vec<Vec2> {
+    (0..64)
+        .map(|k| {
+            let k = k as f64;
+            Vec2::new(
+                (k * 0.618_034).fract() * SIZE as f64,
+                (k * 0.754_877).fract() * SIZE as f64,
+            )
+        })
+        .collect()
+}
+
+/// P-NDF queries: per footprint size, 256 slopes per batch, either half vectors drawn from
+/// the footprint's own P-NDF (a glint is found: the case that matters for shading) or
+/// uniform over θ_h < 40° (mostly empty space).
+fn pndf_query(c: &mut Criterion) {
+    for (kind, (name, _)) in KINDS.iter().enumerate() {
+        let surf = surface(kind);
+        let mut g = c.benchmark_group(format!("pndf-query-{name}-{SIZE}"));
+        g.throughput(Throughput::Elements(256));
+        // σ = 64 visits ~10⁵ lobes per query: 10 samples keep the run to seconds.
+        g.sample_size(10);
+        for sigma in SIGMAS {
+            let queries: Vec<FootprintQuery> = centres()
+                .into_iter()
+                .map(|c| FootprintQuery::new(Footprint::isotropic(c, sigma), SIZE, SIZE))
+                .collect();
+            let mut rng = Pcg32::new(7, 1);
+            // (query index, slope) pairs.
+            let sampled: Vec<(usize, [f64; 2])> = (0..256)
+                .map(|k| {
+                    let q = k % queries.len();
+                    let m = PatchNdf::new(&surf, &queries[q])
+                        .sample_normal(&mut rng)
+                        .unwrap_or(Vec3::Z);
+                    (q, [-m.x / m.z, -m.y / m.z])
+                })
+                .collect();
+            let uniform: Vec<(usize, [f64; 2])> = (0..256)
+                .map(|k| {
+                    let h = spherical_direction(
+                        (k as f64 * 0.618_034).fract() * 40f64.to_radians(),
+                        (k as f64 * 0.754_877).fract() * std::f64::consts::TAU,
+                    );
+                    (k % queries.len(), [-h.x / h.z, -h.y / h.z])
+                })
+                .collect();
+            for (what, set) in [("sampled-h", &sampled), ("uniform-h", &uniform)] {
+                let (mut lobes, mut nonzero) = (0usize, 0usize);
+                for (q, s) in set.iter() {
+                    let (v, n) = PatchNdf::new(&surf, &queries[*q]).p22_counting(*s);
+                    lobes += n;
+                    nonzero += (v > 0.0) as usize;
+                }
+                println!(
+                    "{name} σ = {sigma} texels, {what}: {:.1} lobes visited per query, {nonzero}/256 queries non-zero",
+                    lobes as f64 / 256.0
+                );
+                g.bench_function(format!("sigma-{sigma}-{what}"), |b| {
+                    b.iter(|| {
+                        let mut acc = 0.0;
+                        for (q, s) in black_box(set).iter() {
+                            acc += PatchNdf::new(&surf, &queries[*q]).p22(*s);
+                        }
+                        black_box(acc)
+                    })
+                });
+            }
+        }
+        g.finish();
+    }
+}
+
+/// Building the mixture of a 2048² scratched map: lobes, then lobes + slope hierarchy, then
+/// the whole surface (with the moment pyramid of the approximate masking).
+fn mixture_build(c: &mut Criterion) {
+    let map = generate(NormalMapKind::Scratched, SIZE, 3).unwrap();
+    let mut g = c.benchmark_group(format!("mixture-build-scratched-{SIZE}"));
+    g.sample_size(10);
+    g.bench_function("lobes", |b| {
+        b.iter(|| black_box(build_lobes(&map, DEFAULT_ROUGHNESS_FLOOR)))
+    });
+    g.bench_function("lobes+hierarchy", |b| {
+        b.iter(|| {
+            let lobes = build_lobes(&map, DEFAULT_ROUGHNESS_FLOOR);
+            black_box(SlopeHierarchy::build(&lobes, SIZE, SIZE))
+        })
+    });
+    g.bench_function("surface", |b| {
+        b.iter(|| {
+            black_box(GlintSurface::build(map.clone(), DEFAULT_ROUGHNESS_FLOOR, "bench").unwrap())
+        })
+    });
+    g.finish();
+}
+
+/// eval and sample of the P-BRDF (Al Fresnel) at σ = 4 texels, exact vs approximate masking,
+/// over 256 direction pairs and 16 footprint centres (a new BSDF per footprint, as a
+/// renderer builds one per shading point: its construction is timed separately).
+fn glint_bsdf(c: &mut Criterion) {
+    let dirs: Vec<Vec3> = (0..256)
+        .map(|k| {
+            spherical_direction(
+                (k as f64 * 0.618_034).fract() * 1.3,
+                (k as f64 * 0.754_877).fract() * std::f64::consts::TAU,
+            )
+        })
+        .collect();
+    let al = Fresnel::Conductor {
+        eta: Spectrum::rgb(1.657, 0.880, 0.521),
+        k: Spectrum::rgb(9.224, 6.270, 4.837),
+    };
+    let surf = surface(0);
+    for (mode_name, mode) in [
+        ("exact", MaskingMode::Exact),
+        ("approx", MaskingMode::Approx),
+    ] {
+        let params = GlintParams {
+            fresnel: al,
+            tint: Spectrum::splat(1.0),
+            masking: mode,
+            masking_lobes: DEFAULT_MASKING_LOBES,
+        };
+        let bsdfs: Vec<GlintBsdf> = centres()
+            .into_iter()
+            .take(16)
+            .map(|c| GlintBsdf::new(surf.clone(), Footprint::isotropic(c, 4.0), &params))
+            .collect();
+        let mut g = c.benchmark_group(format!("glint-scratched-{SIZE}-sigma-4-{mode_name}"));
+        g.throughput(Throughput::Elements(256));
+        let ctx = BsdfContext::RADIANCE;
+        g.bench_function("eval", |b| {
+            let mut rng = Pcg32::new(1, 1);
+            b.iter(|| {
+                let d = black_box(&dirs);
+                let mut acc = 0.0;
+                for k in 0..256 {
+                    acc += bsdfs[k % 16].eval(d[k], d[255 - k], &ctx, &mut rng)[0];
+                }
+                black_box(acc)
+            })
+        });
+        g.bench_function("sample", |b| {
+            let mut rng = Pcg32::new(1, 1);
+            b.iter(|| {
+                let d = black_box(&dirs);
+                let mut acc = 0.0;
+                for (k, w) in d.iter().enumerate() {
+                    if let Some(s) = bsdfs[k % 16].sample(*w, &ctx, &mut rng) {
+                        acc += s.weight[0];
+                    }
+                }
+                black_box(acc)
+            })
+        });
+        g.throughput(Throughput::Elements(1));
+        g.bench_function("new-per-shading-point", |b| {
+            let mut k = 0usize;
+            let cs = centres();
+            b.iter(|| {
+                k = (k + 1) % cs.len();
+                black_box(GlintBsdf::new(
+                    surf.clone(),
+                    Footprint::isotropic(cs[k], 4.0),
+                    &params,
+                ))
+            })
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, pndf_query, mixture_build, glint_bsdf);
+criterion_main!(benches);
