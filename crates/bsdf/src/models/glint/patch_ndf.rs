@@ -15,11 +15,14 @@
 //! 2. among the 4×4 seeds nearest u, pick seed i with probability k_i(u)/K_max, or reject
 //!    with the remaining probability 1 − K(u)/K_max (K(u) = Σ k_i(u) over the 4×4 window,
 //!    K_max = its maximum over u, the squared 1-D lattice sum θ(0)² ≈ 1.117);
-//! 3. reject seeds outside T; else draw the slope from lobe i (truncated Gaussian).
+//! 3. if seed i is outside T, return no sample; else draw the slope from lobe i
+//!    (truncated Gaussian).
 //!
-//! The accepted pair (u, i) has density ∝ k_P(u) k_i(u), so P(i) ∝ ∫ k_P k_i du = W_i (the
-//! 4×4 window truncates k_i at ±2 texels, 5e-6 of its mass). The acceptance rate is
-//! Σ_T W_i / K_max ≈ 0.9. For a uniform query the lobe is drawn uniformly.
+//! The accepted pair (u, i) has density ∝ k_P(u) k_i(u), so P(i) = ∫ k_P k_i du / Z = W_i / Z
+//! (the 4×4 window truncates k_i at ±2 texels, 5e-6 of its mass), and no lobe is returned
+//! with probability 1 − Σ_T W_i / Z ≤ e^{−R²/2} = 3.4e-4: exactly the mass that the
+//! truncated D_P (divided by Z, not by Σ_T W_i) lacks. The acceptance rate of step 2 is
+//! Z / K_max ≈ 0.9. For a uniform query the lobe is drawn uniformly.
 
 use super::footprint::{min_quadratic_over_box, FootprintQuery, Weighting};
 use super::lobe::{normal_of_slope, slope_of_normal, standard_normal_2d, CUTOFF_R2};
@@ -143,7 +146,8 @@ impl<'a> PatchNdf<'a> {
         self.d(m) * m.z.max(0.0)
     }
 
-    /// Draws a lobe index with probability W_i/Σ_T W_i (module notes).
+    /// Draws a lobe index with probability W_i/Z, or `None` with the probability
+    /// 1 − Σ_T W_i/Z of a seed outside the truncation T (module notes).
     pub fn sample_lobe(&self, rng: &mut dyn RandomSource) -> Option<usize> {
         let surf = self.surface;
         let (w, h) = (surf.width(), surf.height());
@@ -190,7 +194,13 @@ impl<'a> PatchNdf<'a> {
             let (ix, iy) = (bx + a as i64, by + b as i64);
             let ui = Vec2::new(ix as f64 + 0.5, iy as f64 + 0.5);
             if q.mahalanobis2(ui) > CUTOFF_R2 {
-                continue;
+                // A seed outside T: no lobe. Not a retry: D_P is divided by Z, the weight of
+                // every seed, so it integrates to Σ_T W_i / Z < 1 and the sampler must fail
+                // with the missing probability 1 − Σ_T W_i / Z (retrying would return a lobe
+                // with probability W_i / Σ_T W_i, more than pdf claims, and no failure:
+                // 3.4e-4 of the mass in the wrong place, a chi-square failure of the
+                // "no direction" cell).
+                return None;
             }
             let x = ix.rem_euclid(w as i64) as usize;
             let y = iy.rem_euclid(h as i64) as usize;
@@ -231,9 +241,10 @@ mod tests {
         let ndf = PatchNdf::new(&surf, &q);
         let mut rng = Pcg32::new(1, 2);
         let n = 400_000;
-        let mut counts = vec![0usize; 256];
+        // Cell 256: no lobe (a seed outside the truncation T).
+        let mut counts = vec![0usize; 257];
         for _ in 0..n {
-            counts[ndf.sample_lobe(&mut rng).unwrap()] += 1;
+            counts[ndf.sample_lobe(&mut rng).unwrap_or(256)] += 1;
         }
         let mut expected = vec![0.0; 256];
         for &(tx, ty) in &q.tiles {
@@ -247,11 +258,16 @@ mod tests {
                 }
             }
         }
-        let total: f64 = expected.iter().sum();
+        // P(i) = W_i / Z (not W_i / Σ_T W_i): the probabilities D_P is built from.
+        for e in &mut expected {
+            *e *= q.weight_scale;
+        }
+        let kept: f64 = expected.iter().sum();
+        expected.push(1.0 - kept);
         let mut chi2 = 0.0;
         let mut dof = 0;
-        for k in 0..256 {
-            let e = expected[k] / total * n as f64;
+        for k in 0..257 {
+            let e = expected[k] * n as f64;
             if e > 5.0 {
                 chi2 += (counts[k] as f64 - e).powi(2) / e;
                 dof += 1;
@@ -259,6 +275,8 @@ mod tests {
                 assert!(counts[k] as f64 <= 5.0 * e + 10.0);
             }
         }
+        // The truncated mass is large enough here to be tested (≈ 1e-4 of the draws).
+        assert!(expected[256] * n as f64 > 20.0, "{}", expected[256]);
         // chi2 / dof ≈ 1 for a correct sampler; a 1 % bias would give ~ 40 here.
         assert!(chi2 / (dof as f64) < 1.6, "chi2 {chi2} dof {dof}");
     }
