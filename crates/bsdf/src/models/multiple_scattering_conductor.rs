@@ -5,9 +5,11 @@
 //!
 //! - `eval`: today's single-scattering lobe (the shared specular lobe with the
 //!   height-correlated Smith masking, exactly what `scattering = "single"` returns) plus an
-//!   unbiased estimate of the orders ≥ 2 by one walk from the light direction with
-//!   next-event estimation toward the view. The estimate is stochastic
-//!   ([`Bsdf::is_stochastic`]); its expectation is reciprocal.
+//!   unbiased estimate of the orders ≥ 2 by one walk entering from the more masked of the two
+//!   directions with next-event estimation toward the other
+//!   ([`Microsurface::walk_from_first`]: the low-variance choice). The estimate is
+//!   stochastic ([`Bsdf::is_stochastic`]); as the choice depends on the unordered pair, the
+//!   estimates of f(a, b) and f(b, a) have the same distribution.
 //! - `sample`: the physical walk from `wo`; the weight is the product of the Fresnel factors
 //!   met — exactly 1 for a white conductor, whose albedo is then 1 but for walks longer than
 //!   [`MAX_ORDER`](super::smith_microsurface::MAX_ORDER) (measured negligible).
@@ -22,7 +24,7 @@ use super::compensated_conductor::CompensatedConductor;
 use super::rough_conductor::RoughConductor;
 use super::smith_microsurface::{FacetScattering, HeightDistribution, Microsurface};
 use super::{flip, to_upper_pair};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
+use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
@@ -123,6 +125,25 @@ impl MultipleScatteringConductor {
         };
         self.surface.estimate(&self.facets, i, o, min_order, rng) / o.z
     }
+
+    /// [`Self::estimate_orders`] with the choice of the next-event masking factor
+    /// ([`Microsurface::estimate_with`]): `expected_masking = false` is HHdD16's estimator
+    /// as printed, whose variance is huge for Beckmann (kept to measure it).
+    pub fn estimate_orders_with(
+        &self,
+        i: Vec3,
+        o: Vec3,
+        min_order: usize,
+        expected_masking: bool,
+        rng: &mut dyn RandomSource,
+    ) -> Spectrum {
+        let Some((o, i)) = to_upper_pair(o, i) else {
+            return Spectrum::ZERO;
+        };
+        self.surface
+            .estimate_with(&self.facets, i, o, min_order, expected_masking, rng)
+            / o.z
+    }
 }
 
 /// The multiple-scattering models' requirements on the lobe they extend.
@@ -162,9 +183,13 @@ impl Bsdf for MultipleScatteringConductor {
         let Some((o, i)) = to_upper_pair(wo, wi) else {
             return Spectrum::ZERO;
         };
-        let (light, view) = match ctx.mode {
-            TransportMode::Radiance => (i, o),
-            TransportMode::Importance => (o, i),
+        // The walk enters from the more masked of the two directions (the estimator's
+        // variance, `Microsurface::walk_from_first`); the conductor is reciprocal, so the
+        // transport mode does not matter.
+        let (light, view) = if self.surface.walk_from_first(i, o) {
+            (i, o)
+        } else {
+            (o, i)
         };
         let higher = self.surface.estimate(&self.facets, light, view, 2, rng) / view.z;
         let v = self.single.eval(wo, wi, ctx, rng) + higher;

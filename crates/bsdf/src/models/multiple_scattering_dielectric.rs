@@ -13,10 +13,12 @@
 //!
 //! - `eval`: WMLT07's single-scattering BSDF with the height-correlated Smith masking
 //!   (exactly `scattering = "single"` with that masking) plus an unbiased estimate of the
-//!   orders ≥ 2 by one walk from the light direction (radiance mode: `wi`; importance mode:
-//!   `wo`) with next-event estimation toward the other — the walk carries flux, so the
-//!   estimate is f(i, o) in WMLT07's convention, whose BTDF is not reciprocal
-//!   (f(i,o)/η_o² = f(o,i)/η_i², ERRATA 11).
+//!   orders ≥ 2 by one walk with next-event estimation toward the other direction — the
+//!   walk carries flux, so entered from the light direction `i` (radiance mode: `wi`;
+//!   importance mode: `wo`) it estimates f(i, o) in WMLT07's convention, whose BTDF is not
+//!   reciprocal (f(i,o)/η_o² = f(o,i)/η_i², ERRATA 11). The walk enters from the more masked
+//!   of the two directions ([`Microsurface::walk_from_first`]: the low-variance choice); when
+//!   that is `o` it estimates f(o, i), scaled by (η_o/η_i)².
 //! - `sample`: the physical walk from `wo`, which simulates f(i = wo, o = wi) |wi·n|: its
 //!   weight is the product of the tints met, times (η_o/η_i)² in radiance mode when it left
 //!   on the other side (the radiance compression of the adjoint, as in
@@ -201,7 +203,16 @@ impl Bsdf for MultipleScatteringDielectric {
             TransportMode::Radiance => (wi, wo),
             TransportMode::Importance => (wo, wi),
         };
-        let v = self.single.eval(wo, wi, ctx, rng) + self.estimate_orders(i, o, 2, rng);
+        // The walk enters from the more masked direction (`Microsurface::walk_from_first`, the
+        // estimator's variance); entered from `o` it estimates f(o, i), and the generalized
+        // reciprocity f(i, o)/η_o² = f(o, i)/η_i² (ERRATA 11) gives f(i, o).
+        let higher = if self.surface.walk_from_first(i, o) {
+            self.estimate_orders(i, o, 2, rng)
+        } else {
+            let r = self.index(o) / self.index(i);
+            self.estimate_orders(o, i, 2, rng) * (r * r)
+        };
+        let v = self.single.eval(wo, wi, ctx, rng) + higher;
         if v.is_finite() {
             v
         } else {
