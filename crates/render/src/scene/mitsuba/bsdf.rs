@@ -154,6 +154,15 @@ fn native_material(
 }
 
 /// `distribution`, `alpha` or `alpha_u` + `alpha_v` (textures allowed), `sample_visible`.
+/// The parameters [`microfacet`] reads (rough conductors and dielectrics).
+const MICROFACET_KEYS: [&str; 5] = [
+    "distribution",
+    "alpha",
+    "alpha_u",
+    "alpha_v",
+    "sample_visible",
+];
+
 fn microfacet(
     cx: &mut Translator,
     p: &Plugin,
@@ -256,13 +265,7 @@ fn conductor(
     }
     let mut keys = vec!["material", "eta", "k", "specular_reflectance"];
     if rough {
-        keys.extend([
-            "distribution",
-            "alpha",
-            "alpha_u",
-            "alpha_v",
-            "sample_visible",
-        ]);
+        keys.extend(MICROFACET_KEYS);
     }
     p.finish(&keys, &cx.reg)
 }
@@ -299,13 +302,7 @@ fn dielectric(
         "specular_transmittance",
     ];
     if rough {
-        keys.extend([
-            "distribution",
-            "alpha",
-            "alpha_u",
-            "alpha_v",
-            "sample_visible",
-        ]);
+        keys.extend(MICROFACET_KEYS);
     }
     p.finish(&keys, &cx.reg)
 }
