@@ -430,6 +430,10 @@ fn material_syntax_builds_and_reports_errors() {
             r#"{type = "glint", generate = "bumpy", normal_encoding = "signed"}"#,
             "applies to a `normal_map` file",
         ),
+        (
+            r#"{type = "glint", generate = "bumpy", evaluation = "brute"}"#,
+            "patch, reference",
+        ),
     ];
     for (s, msg) in bad {
         let e = build_material(&parse_inline_table(s).unwrap())
@@ -529,4 +533,37 @@ fn sampler_passes_chi_square_and_the_bsdf_checks_at_fixed_footprints() {
         .map(|c| format!("{c:?}"))
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// `evaluation = "reference"`: per shading point, the map at the hit's uv (the footprint
+/// centre, derivatives ignored) as one σ_ε lobe around the interpolated normal.
+#[test]
+fn the_reference_evaluation_is_the_interpolated_map_at_the_hit() {
+    use facette_bsdf::models::glint::lobe::normal_of_slope;
+    let t = parse_inline_table(
+        r#"{type = "glint", generate = "bumpy", resolution = 32, uv_scale = 2, roughness_floor = 0.02, evaluation = "reference"}"#,
+    )
+    .unwrap();
+    let r = MaterialRecipe::parse(&t, std::path::Path::new(".")).unwrap();
+    let MaterialRecipe::Glint(g) = &r else {
+        panic!()
+    };
+    let uv = Vec2::new(0.3, 0.7);
+    let b = r.build_at(uv, [0.01, 0.0, 0.0, 0.01]).unwrap();
+    assert!(b.describe().contains("reference point"), "{}", b.describe());
+    // The mirror configuration about the interpolated normal is the lobe's peak.
+    let n = normal_of_slope(
+        g.surface
+            .map()
+            .interpolated_slope(Vec2::new(0.3 * 64.0, 0.7 * 64.0)),
+    );
+    let mut rng = Pcg32::new(1, 1);
+    let peak = b.eval(n, n, &BsdfContext::RADIANCE, &mut rng);
+    let off = b.eval(
+        n,
+        (n + Vec3::new(0.0, 0.2, 0.0)).normalize(),
+        &BsdfContext::RADIANCE,
+        &mut rng,
+    );
+    assert!(peak[0] > 1.0 && off[0] < 1e-6 * peak[0], "{peak:?} {off:?}");
 }

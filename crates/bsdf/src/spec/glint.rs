@@ -16,6 +16,7 @@
 //! | `uv_scale` | map repetitions per unit of uv (number or [u, v]) | > 0 | 1 |
 //! | `roughness_floor` | σ_ε, slope standard deviation added to every lobe | (0, 1] | 0.01 |
 //! | `masking` | `exact` (eqs. 10–17) or `approx` (§4.2.2) | — | `exact` |
+//! | `evaluation` | `patch` (the P-BRDF of the footprint) or `reference` (brute force: the map at the shading point's uv as a σ_ε surface, no footprint; converges with samples per pixel) | — | `patch` |
 //! | `masking_lobes` | budget of the exact masking sum (0: unlimited) | ≥ 0 | 1024 |
 //! | `footprint_center` | footprint centre in uv when none is given by a renderer | any | [0.5, 0.5] |
 //! | `footprint_size` | footprint standard deviation in texels: σ, [σ_u, σ_v] or [σ_u, σ_v, ρ] | σ ≥ 0, ρ ∈ (−1, 1) | 2 |
@@ -42,7 +43,7 @@ use crate::models::glint::generate::{generate, NormalMapKind};
 use crate::models::glint::microsurface::DEFAULT_ROUGHNESS_FLOOR;
 use crate::models::glint::patch_masking::{MaskingMode, DEFAULT_MASKING_LOBES};
 use crate::models::glint::{
-    Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap,
+    Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap, PointReferenceBsdf,
 };
 use std::path::Path;
 use std::sync::Arc;
@@ -58,6 +59,7 @@ pub const GLINT_KEYS: &[&str] = &[
     "roughness_floor",
     "masking",
     "masking_lobes",
+    "evaluation",
     "footprint_center",
     "footprint_size",
     "material",
@@ -100,6 +102,9 @@ pub struct GlintRecipe {
     /// Footprint used without derivatives: centre (uv) and (σ_u, σ_v, ρ) in texels.
     pub footprint_center: [f64; 2],
     pub footprint_size: [f64; 3],
+    /// `evaluation = "reference"`: [`PointReferenceBsdf`] at the shading point instead of
+    /// the P-BRDF of its footprint.
+    pub reference: bool,
 }
 
 impl GlintRecipe {
@@ -126,8 +131,19 @@ impl GlintRecipe {
         self.build_at(c, [0.0; 4])
     }
 
-    /// The BSDF of a shading point.
+    /// The BSDF of a shading point: the P-BRDF of its footprint, or with `evaluation =
+    /// "reference"` the brute-force reference at the footprint's centre.
     pub fn build_at(&self, uv: Vec2, derivs: [f64; 4]) -> Arc<dyn Bsdf> {
+        if self.reference {
+            let center = self.footprint_at(uv, [0.0; 4]).center;
+            return Arc::new(PointReferenceBsdf::new(
+                self.surface.map(),
+                center,
+                self.surface.roughness_floor(),
+                self.params.fresnel,
+                self.params.tint,
+            ));
+        }
         Arc::new(self.bsdf_at(uv, derivs))
     }
 
@@ -280,6 +296,17 @@ pub fn parse_glint(
     )?;
     let masking = MaskingMode::parse(p.str("masking")?.unwrap_or("exact"))?;
     let masking_lobes = p.usize("masking_lobes")?.unwrap_or(DEFAULT_MASKING_LOBES);
+    let reference = match p.str("evaluation")?.unwrap_or("patch") {
+        "patch" => false,
+        "reference" => true,
+        other => {
+            return Err(ParamError::UnknownChoice {
+                what: "glint evaluation".into(),
+                given: other.into(),
+                valid: "patch, reference".into(),
+            })
+        }
+    };
     let fresnel = super::material::parse_conductor_fresnel(p)?;
     let tint = check_spectrum(
         "specular_reflectance",
@@ -299,5 +326,6 @@ pub fn parse_glint(
         uv_scale,
         footprint_center,
         footprint_size,
+        reference,
     })
 }

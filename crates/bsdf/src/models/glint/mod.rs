@@ -19,7 +19,8 @@
 //! - [`patch_masking`]: exact (eqs. 10–17) and approximate (§4.2.2) masking;
 //! - [`surface`]: the precomputed data of one map, shared by every shading point;
 //! - [`glint_bsdf`]: the P-BRDF (eq. 7) implementing [`crate::Bsdf`];
-//! - [`reference`]: the ground-truth slope histogram of a footprint.
+//! - [`reference`]: the ground-truth slope histogram of a footprint;
+//! - [`point_reference`]: the brute-force reference BSDF (the map at one point, σ_ε).
 //!
 //! Units: positions on the map in texels (texel centres at half-integers), slopes
 //! unitless, footprints as covariances in texels².
@@ -34,6 +35,7 @@ pub mod mip_levels;
 pub mod normal_map;
 pub mod patch_masking;
 pub mod patch_ndf;
+pub mod point_reference;
 pub mod reference;
 pub mod surface;
 
@@ -42,4 +44,5 @@ pub use generate::{generate, NormalMapKind};
 pub use glint_bsdf::{GlintBsdf, GlintParams};
 pub use normal_map::{NormalEncoding, NormalMap};
 pub use patch_masking::MaskingMode;
+pub use point_reference::PointReferenceBsdf;
 pub use surface::GlintSurface;
