@@ -19,13 +19,13 @@
 use super::footprint::{Footprint, FootprintQuery};
 use super::patch_masking::{MaskingMode, PatchMasking};
 use super::patch_ndf::PatchNdf;
+use super::patch_reflection::{self, PatchReflection};
 use super::surface::GlintSurface;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::{fmt_num, reflect, Vec3};
-use crate::models::{flip, to_upper_pair};
+use crate::math::{fmt_num, Vec3};
 use std::sync::{Arc, Mutex};
 
 /// Material parameters besides the surface and the footprint.
@@ -96,32 +96,32 @@ impl GlintBsdf {
         }
         self.masking.visible_projected_area(v)
     }
+}
 
-    /// f_P for an upper-hemisphere pair.
-    fn eval_upper(&self, o: Vec3, i: Vec3) -> Spectrum {
-        let h = (o + i).normalize_or_zero();
-        let cos_oh = o.dot(h);
-        if !(h.z > 0.0) || !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
-            return Spectrum::ZERO;
-        }
-        self.eval_with_d(o, i, cos_oh, self.ndf().d(h))
+impl PatchReflection for GlintBsdf {
+    /// D_P(h)  [CCM19 eq. 9].
+    fn d(&self, h: Vec3) -> f64 {
+        self.ndf().d(h)
     }
 
-    /// f_P given D_P(h) (the sampler has it already: one P-NDF query per sample).
-    fn eval_with_d(&self, o: Vec3, i: Vec3, cos_oh: f64, d: f64) -> Spectrum {
-        if !(d > 0.0) {
-            return Spectrum::ZERO;
-        }
-        let io = self.visible_area(o);
-        let ii = self.masking.visible_projected_area(i);
-        if !(io > 0.0 && ii > 0.0) {
-            return Spectrum::ZERO;
-        }
-        let v = d / (4.0 * io * ii);
-        if !v.is_finite() {
-            return Spectrum::ZERO;
-        }
-        self.tint * self.fresnel.eval(cos_oh) * v
+    fn sample_normal(&self, rng: &mut dyn RandomSource) -> Option<Vec3> {
+        self.ndf().sample_normal(rng)
+    }
+
+    fn view_area(&self, o: Vec3) -> f64 {
+        self.visible_area(o)
+    }
+
+    fn light_area(&self, i: Vec3) -> f64 {
+        self.masking.visible_projected_area(i)
+    }
+
+    fn fresnel(&self) -> &Fresnel {
+        &self.fresnel
+    }
+
+    fn tint(&self) -> Spectrum {
+        self.tint
     }
 }
 
@@ -131,68 +131,15 @@ impl Bsdf for GlintBsdf {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => self.eval_upper(o, i),
-            None => Spectrum::ZERO,
-        }
+        patch_reflection::eval(self, wo, wi)
     }
 
     fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
-        if wo.z == 0.0 || !wo.is_finite() {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
-        let ndf = self.ndf();
-        let m = ndf.sample_normal(rng)?;
-        let cos_om = o.dot(m);
-        if !(cos_om > 0.0) {
-            return None;
-        }
-        let i = reflect(o, m).normalize();
-        if !(i.z > 0.0) {
-            return None;
-        }
-        // The pdf is evaluated at the half vector of (o, i), exactly as `pdf` will.
-        let h = (o + i).normalize();
-        let cos_oh = o.dot(h);
-        if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
-            return None;
-        }
-        let d = ndf.d(h);
-        let pdf = d * h.z.max(0.0) / (4.0 * cos_oh);
-        if !(pdf > 0.0) || !pdf.is_finite() {
-            return None;
-        }
-        let f = self.eval_with_d(o, i, cos_oh, d);
-        let weight = f * (i.z / pdf);
-        if !weight.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
-            weight,
-            pdf,
-            lobe: LobeFlags::GLOSSY_REFLECTION,
-            eta: 1.0,
-        })
+        patch_reflection::sample(self, wo, rng)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return 0.0;
-        };
-        let h = (o + i).normalize_or_zero();
-        let cos_oh = o.dot(h);
-        if !(h.z > 0.0) || !(cos_oh > 0.0) {
-            return 0.0;
-        }
-        let p = self.ndf().pdf_normal(h) / (4.0 * cos_oh);
-        if p.is_finite() {
-            p
-        } else {
-            0.0
-        }
+        patch_reflection::pdf(self, wo, wi)
     }
 
     /// The RMS slope of the footprint's distribution (at least 0.15, so the validation

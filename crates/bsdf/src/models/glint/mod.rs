@@ -18,6 +18,7 @@
 //! - [`patch_ndf`]: D_P (eq. 9) and its sampler;
 //! - [`patch_masking`]: exact (eqs. 10–17) and approximate (§4.2.2) masking;
 //! - [`surface`]: the precomputed data of one map, shared by every shading point;
+//! - [`patch_reflection`]: eq. 7 and its sampling given a patch's D and projected area;
 //! - [`glint_bsdf`]: the P-BRDF (eq. 7) implementing [`crate::Bsdf`];
 //! - [`reference`]: the ground-truth slope histogram of a footprint;
 //! - [`point_reference`]: the brute-force reference BSDF (the map at one point, σ_ε).
@@ -35,6 +36,7 @@ pub mod mip_levels;
 pub mod normal_map;
 pub mod patch_masking;
 pub mod patch_ndf;
+mod patch_reflection;
 pub mod point_reference;
 pub mod reference;
 pub mod surface;

@@ -11,19 +11,19 @@
 //! point's uv (`evaluation = "reference"` of the `glint` material) and ignores the ray
 //! footprint: averaging many samples per pixel integrates the normal map over the pixel by
 //! brute force, which the P-NDF does analytically  [CCM19 eqs. 8–9]. No seeds, no
-//! hierarchy: nothing of the glint machinery but the lobe's closed forms is shared.
+//! hierarchy: it shares only the lobe's closed forms and eq. 7 ([`super::patch_reflection`]).
 //!
 //! Sampling draws the lobe's (truncated) slope distribution, mirrored; its pdf
 //! D(h) cos θ_h / (4 o·h) is the density of that draw  [WMLT07 eqs. 14, 38].
 
 use super::lobe::{normal_of_slope, LobeF64, SlopeLobe};
 use super::normal_map::NormalMap;
+use super::patch_reflection::{self, PatchReflection};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::{reflect, Vec2, Vec3};
-use crate::models::{flip, to_upper_pair};
+use crate::math::{Vec2, Vec3};
 
 /// One point of a normal-mapped near-specular conductor.
 pub struct PointReferenceBsdf {
@@ -60,7 +60,9 @@ impl PointReferenceBsdf {
     pub fn mean_normal(&self) -> Vec3 {
         normal_of_slope(self.moments.mean)
     }
+}
 
+impl PatchReflection for PointReferenceBsdf {
     /// D(h) of the truncated lobe.
     fn d(&self, h: Vec3) -> f64 {
         if h.z <= 0.0 {
@@ -71,22 +73,24 @@ impl PointReferenceBsdf {
         self.lobe.p22(s) / (z2 * z2)
     }
 
-    fn eval_with_d(&self, o: Vec3, i: Vec3, cos_oh: f64, d: f64) -> Spectrum {
-        if !(d > 0.0) {
-            return Spectrum::ZERO;
-        }
-        let (io, ii) = (
-            self.moments.visible_projected_area(o),
-            self.moments.visible_projected_area(i),
-        );
-        if !(io > 0.0 && ii > 0.0) {
-            return Spectrum::ZERO;
-        }
-        let v = d / (4.0 * io * ii);
-        if !v.is_finite() {
-            return Spectrum::ZERO;
-        }
-        self.tint * self.fresnel.eval(cos_oh) * v
+    fn sample_normal(&self, rng: &mut dyn RandomSource) -> Option<Vec3> {
+        Some(normal_of_slope(self.moments.sample_slope(rng.next_2d())))
+    }
+
+    fn view_area(&self, o: Vec3) -> f64 {
+        self.moments.visible_projected_area(o)
+    }
+
+    fn light_area(&self, i: Vec3) -> f64 {
+        self.moments.visible_projected_area(i)
+    }
+
+    fn fresnel(&self) -> &Fresnel {
+        &self.fresnel
+    }
+
+    fn tint(&self) -> Spectrum {
+        self.tint
     }
 }
 
@@ -96,70 +100,15 @@ impl Bsdf for PointReferenceBsdf {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return Spectrum::ZERO;
-        };
-        let h = (o + i).normalize_or_zero();
-        let cos_oh = o.dot(h);
-        if !(h.z > 0.0) || !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
-            return Spectrum::ZERO;
-        }
-        self.eval_with_d(o, i, cos_oh, self.d(h))
+        patch_reflection::eval(self, wo, wi)
     }
 
     fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
-        if wo.z == 0.0 || !wo.is_finite() {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
-        let m = normal_of_slope(self.moments_sample(rng.next_2d()));
-        if !(o.dot(m) > 0.0) {
-            return None;
-        }
-        let i = reflect(o, m).normalize();
-        if !(i.z > 0.0) {
-            return None;
-        }
-        // pdf and f at the half vector of (o, i), exactly as `pdf` and `eval` compute them.
-        let h = (o + i).normalize();
-        let cos_oh = o.dot(h);
-        if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
-            return None;
-        }
-        let d = self.d(h);
-        let pdf = d * h.z / (4.0 * cos_oh);
-        if !(pdf > 0.0) || !pdf.is_finite() {
-            return None;
-        }
-        let weight = self.eval_with_d(o, i, cos_oh, d) * (i.z / pdf);
-        if !weight.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
-            weight,
-            pdf,
-            lobe: LobeFlags::GLOSSY_REFLECTION,
-            eta: 1.0,
-        })
+        patch_reflection::sample(self, wo, rng)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return 0.0;
-        };
-        let h = (o + i).normalize_or_zero();
-        let cos_oh = o.dot(h);
-        if !(h.z > 0.0) || !(cos_oh > 0.0) {
-            return 0.0;
-        }
-        let p = self.d(h) * h.z / (4.0 * cos_oh);
-        if p.is_finite() {
-            p
-        } else {
-            0.0
-        }
+        patch_reflection::pdf(self, wo, wi)
     }
 
     /// At least 0.15 so that validation bins cover the lobe's neighbourhood.
@@ -176,12 +125,6 @@ impl Bsdf for PointReferenceBsdf {
             n.z,
             self.moments.cov[0].sqrt()
         )
-    }
-}
-
-impl PointReferenceBsdf {
-    fn moments_sample(&self, u: Vec2) -> [f64; 2] {
-        self.moments.sample_slope(u)
     }
 }
 

@@ -1,0 +1,125 @@
+//! The reflection of one patch given its normal distribution  [CCM19 eq. 7]:
+//!
+//!   f(o, i) = F(o·h) χ⁺(o·h) χ⁺(i·h) D(h) / (4 I(o) I(i)),
+//!
+//! with I the patch's visible projected area, and its sampling: a normal of D, mirrored,
+//! with pdf D(h) cos θ_h / (4 o·h)  [WMLT07 eqs. 14, 38]. Shared by the P-BRDF of a footprint
+//! ([`super::GlintBsdf`]) and the one-lobe brute-force reference
+//! ([`super::PointReferenceBsdf`]), which differ only in D, its sampler and I.
+
+use crate::bsdf::{BsdfSample, LobeFlags};
+use crate::fresnel::Fresnel;
+use crate::math::rng::RandomSource;
+use crate::math::spectrum::Spectrum;
+use crate::math::{reflect, Vec3};
+use crate::models::{flip, to_upper_pair};
+
+/// What distinguishes one patch model from another.
+pub(crate) trait PatchReflection {
+    /// D(h) of the patch (0 below the horizon).
+    fn d(&self, h: Vec3) -> f64;
+    /// A normal drawn from D(m) cos θ_m; `None` when the draw fails.
+    fn sample_normal(&self, rng: &mut dyn RandomSource) -> Option<Vec3>;
+    /// I(v), the visible projected area, for the view direction (may be cached).
+    fn view_area(&self, o: Vec3) -> f64;
+    /// I(v) for the light direction.
+    fn light_area(&self, i: Vec3) -> f64;
+    fn fresnel(&self) -> &Fresnel;
+    fn tint(&self) -> Spectrum;
+}
+
+/// f for an upper-hemisphere pair given D(h) (the sampler has it already).
+pub(crate) fn eval_with_d(
+    p: &impl PatchReflection,
+    o: Vec3,
+    i: Vec3,
+    cos_oh: f64,
+    d: f64,
+) -> Spectrum {
+    if !(d > 0.0) {
+        return Spectrum::ZERO;
+    }
+    let (io, ii) = (p.view_area(o), p.light_area(i));
+    if !(io > 0.0 && ii > 0.0) {
+        return Spectrum::ZERO;
+    }
+    let v = d / (4.0 * io * ii);
+    if !v.is_finite() {
+        return Spectrum::ZERO;
+    }
+    p.tint() * p.fresnel().eval(cos_oh) * v
+}
+
+/// f(wo, wi), both sides of the surface.
+pub(crate) fn eval(p: &impl PatchReflection, wo: Vec3, wi: Vec3) -> Spectrum {
+    let Some((o, i)) = to_upper_pair(wo, wi) else {
+        return Spectrum::ZERO;
+    };
+    let h = (o + i).normalize_or_zero();
+    let cos_oh = o.dot(h);
+    if !(h.z > 0.0) || !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
+        return Spectrum::ZERO;
+    }
+    eval_with_d(p, o, i, cos_oh, p.d(h))
+}
+
+/// One D query per sample: the pdf and f are evaluated at the half vector of (o, i), exactly
+/// as [`pdf`] and [`eval`] compute them.
+pub(crate) fn sample(
+    p: &impl PatchReflection,
+    wo: Vec3,
+    rng: &mut dyn RandomSource,
+) -> Option<BsdfSample> {
+    if wo.z == 0.0 || !wo.is_finite() {
+        return None;
+    }
+    let below = wo.z < 0.0;
+    let o = if below { flip(wo) } else { wo };
+    let m = p.sample_normal(rng)?;
+    if !(o.dot(m) > 0.0) {
+        return None;
+    }
+    let i = reflect(o, m).normalize();
+    if !(i.z > 0.0) {
+        return None;
+    }
+    let h = (o + i).normalize();
+    let cos_oh = o.dot(h);
+    if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
+        return None;
+    }
+    let d = p.d(h);
+    let pdf = d * h.z.max(0.0) / (4.0 * cos_oh);
+    if !(pdf > 0.0) || !pdf.is_finite() {
+        return None;
+    }
+    let weight = eval_with_d(p, o, i, cos_oh, d) * (i.z / pdf);
+    if !weight.is_finite() {
+        return None;
+    }
+    Some(BsdfSample {
+        wi: if below { flip(i) } else { i },
+        weight,
+        pdf,
+        lobe: LobeFlags::GLOSSY_REFLECTION,
+        eta: 1.0,
+    })
+}
+
+/// The density of [`sample`].
+pub(crate) fn pdf(p: &impl PatchReflection, wo: Vec3, wi: Vec3) -> f64 {
+    let Some((o, i)) = to_upper_pair(wo, wi) else {
+        return 0.0;
+    };
+    let h = (o + i).normalize_or_zero();
+    let cos_oh = o.dot(h);
+    if !(h.z > 0.0) || !(cos_oh > 0.0) {
+        return 0.0;
+    }
+    let v = p.d(h) * h.z / (4.0 * cos_oh);
+    if v.is_finite() {
+        v
+    } else {
+        0.0
+    }
+}
