@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use facette_render::integrator::Strategy;
 use facette_render::render::{render, RenderOptions};
+use facette_render::sampler::SamplerKind;
 use facette_render::scene::{load_scene_with, LoadOptions};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -56,6 +57,10 @@ pub struct RenderArgs {
     /// Which estimators to use.
     #[arg(long, value_enum, default_value = "mis")]
     strategy: StrategyArg,
+    /// Pixel sampler (overrides the scene's film `sampler`): `sobol` (Owen-scrambled
+    /// Sobol in Morton order, the default), `independent` or `stratified`.
+    #[arg(long, value_name = "NAME", value_parser = parse_sampler)]
+    sampler: Option<SamplerKind>,
     /// Render part K of N of the samples (K from 0) and write the exact partial result to
     /// a `.fcpart` file for `facette merge` (distributed rendering; see docs/scale-out.md).
     #[arg(long, value_name = "K/N")]
@@ -63,6 +68,16 @@ pub struct RenderArgs {
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
+}
+
+/// Parses a sampler name, listing the valid ones when it is unknown.
+fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
+    SamplerKind::parse(s).ok_or_else(|| {
+        format!(
+            "unknown sampler `{s}`; valid: {}",
+            SamplerKind::NAMES.join(", ")
+        )
+    })
 }
 
 /// Parses `K/N` with 0 ≤ K < N.
@@ -168,6 +183,7 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
         threads: a.threads,
         time_limit: a.time_limit,
         part: None,
+        sampler: a.sampler,
         strategy: match a.strategy {
             StrategyArg::Mis => Strategy::Mis,
             StrategyArg::Nee => Strategy::NeeOnly,

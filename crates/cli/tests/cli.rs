@@ -680,6 +680,31 @@ fn render_parts_merge_exactly_and_bad_sets_are_refused() {
         "the seed",
     );
     bad(vec![parts[0].clone(), part(1, 4, "9")], "the part count");
+    let other_sampler = dir.path().join("p0of3independent.fcpart");
+    let o = facette(
+        &[
+            "render",
+            s,
+            "--part",
+            "0/3",
+            "--seed",
+            "9",
+            "--sampler",
+            "independent",
+            "-o",
+            other_sampler.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    bad(
+        vec![
+            parts[0].clone(),
+            parts[1].clone(),
+            other_sampler.to_str().unwrap().into(),
+        ],
+        "the sampler is sobol in the first part and independent",
+    );
     std::fs::write(
         &scene,
         TINY_SCENE.replace("intensity = 10", "intensity = 11"),
@@ -693,6 +718,58 @@ fn render_parts_merge_exactly_and_bad_sets_are_refused() {
         "junk.fcpart",
     );
     assert!(!dir.path().join("bad.exr").exists());
+}
+
+#[test]
+fn render_sampler_flag_overrides_the_scene_and_lists_the_valid_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("tiny.toml");
+    std::fs::write(&scene, TINY_SCENE).unwrap();
+    let s = scene.to_str().unwrap();
+    let render = |sampler: &str| {
+        let out = dir.path().join(format!("{sampler}.exr"));
+        let o = facette(
+            &[
+                "render",
+                s,
+                "--sampler",
+                sampler,
+                "-q",
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            None,
+        );
+        (o, out)
+    };
+    let mut images = Vec::new();
+    for name in ["sobol", "independent", "stratified"] {
+        let (o, out) = render(name);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let img =
+            facette_render::image::read_image(&out, facette_render::image::ColorEncoding::Linear)
+                .unwrap();
+        assert!(img
+            .data()
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite() && *v >= 0.0));
+        images.push(img);
+    }
+    assert_ne!(images[0].data(), images[1].data(), "sobol = independent");
+    assert_ne!(
+        images[1].data(),
+        images[2].data(),
+        "independent = stratified"
+    );
+    let (o, out) = render("halton");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("unknown sampler `halton`; valid: sobol, independent, stratified"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
 }
 
 #[test]

@@ -5,6 +5,16 @@
 //! refraction (the BSDF's radiance-mode weights carry (η_o/η_i)²; Russian roulette looks at
 //! the throughput with that factor removed, as pbrt-v4 does).
 //!
+//! Random numbers come from the camera sample's [`SampleStream`], in a fixed layout of
+//! dimensions so that a low-discrepancy sampler stratifies each decision across the
+//! pixel's samples: the camera takes dimensions 0–3 (filter, lens), and the path vertex
+//! `k` (the first hit is 0) the block of [`VERTEX_DIMENSIONS`] starting at
+//! `CAMERA_DIMENSIONS + k · VERTEX_DIMENSIONS`: light selection (1), light position (2),
+//! BSDF lobe (1), BSDF direction (2), Russian roulette (1). The block does not depend on
+//! how many numbers earlier vertices used. Numbers without a dimension — a stochastic
+//! BSDF's evaluation, a sampler's draws beyond its lobe and direction — come from the
+//! sample's own PCG stream.
+//!
 //! Shading uses the shading normal's frame; a direction whose side of the geometric normal
 //! disagrees with its side of the shading normal is discarded (no light leaks through
 //! interpolated normals). Texture footprints come from the camera ray's differentials at
@@ -12,9 +22,15 @@
 
 use crate::geometry::{Ray, RayDifferential, SurfaceHit, Vec3};
 use crate::lights::Light;
+use crate::sampler::{PrefixedSource, SampleStream};
 use crate::scene::Scene;
-use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::{BsdfContext, LobeFlags, Spectrum};
+
+/// Dimensions the camera sample takes: the filter offset (2) and the lens position (2).
+pub const CAMERA_DIMENSIONS: u32 = 4;
+/// Dimensions each path vertex takes: light selection (1), light position (2), BSDF lobe
+/// (1), BSDF direction (2), Russian roulette (1).
+pub const VERTEX_DIMENSIONS: u32 = 7;
 
 #[inline]
 fn power_heuristic(a: f64, b: f64) -> f64 {
@@ -43,7 +59,7 @@ pub fn radiance(
     scene: &Scene,
     ray: Ray,
     rd: Option<RayDifferential>,
-    rng: &mut Pcg32,
+    sampler: &mut SampleStream,
     strategy: Strategy,
 ) -> Spectrum {
     let settings = scene.integrator;
@@ -86,7 +102,7 @@ pub fn radiance(
                     _ if delta_prev => 1.0,
                     Strategy::Mis => {
                         let pl = scene.selector.probability(li as usize)
-                            * light.pdf_area_hit(&scene.geometry, prev_p, hit.p, hit.ng);
+                            * light.pdf_area_hit(&scene.geometry, prev_p, hit.p, hit.ng, hit.prim);
                         power_heuristic(prev_pdf, pl)
                     }
                     Strategy::NeeOnly => 0.0,
@@ -109,12 +125,20 @@ pub fn radiance(
         let frame = hit.shading_frame();
         let wo = frame.to_local(-ray.dir);
         let flags = bsdf.flags();
-        // Next-event estimation.
+        sampler.set_dimension(CAMERA_DIMENSIONS + (segment - 1) * VERTEX_DIMENSIONS);
+        // Next-event estimation (its dimensions are taken whether or not it runs).
+        let light_choice = sampler.get_1d();
+        let light_position = sampler.get_2d();
         if flags.has_smooth_part() && strategy != Strategy::BsdfOnly {
-            l += beta * sample_light(scene, &hit, &frame, wo, &*bsdf, rng, strategy);
+            let u = (light_choice, light_position);
+            l += beta * sample_light(scene, &hit, &frame, wo, &*bsdf, u, sampler, strategy);
         }
         // Continue by BSDF sampling.
-        let Some(s) = bsdf.sample(wo, &ctx, rng) else {
+        let lobe = sampler.get_1d();
+        let direction = sampler.get_2d();
+        let roulette = sampler.get_1d();
+        let mut source = PrefixedSource::new(lobe, direction, sampler.rng());
+        let Some(s) = bsdf.sample(wo, &ctx, &mut source) else {
             break;
         };
         let wi = frame.to_world(s.wi);
@@ -131,7 +155,7 @@ pub fn radiance(
         segment += 1;
         if segment > settings.rr_depth {
             let q = (beta.max_component() * eta_scale).min(0.95);
-            if !(q > 0.0) || rng.next_f64() >= q {
+            if !(q > 0.0) || roulette >= q {
                 break;
             }
             beta /= q;
@@ -147,20 +171,24 @@ fn consistent_side(hit: &SurfaceHit, wi_world: Vec3, wi_local: Vec3) -> bool {
     wi_world.dot(hit.ng) * wi_local.z > 0.0
 }
 
-/// One light sample: its MIS-weighted contribution (without the path throughput).
+/// One light sample, from the light-selection and light-position numbers `u`: its
+/// MIS-weighted contribution (without the path throughput).
+#[allow(clippy::too_many_arguments)]
 fn sample_light(
     scene: &Scene,
     hit: &SurfaceHit,
     frame: &facette_bsdf::math::Frame,
     wo: Vec3,
     bsdf: &dyn facette_bsdf::Bsdf,
-    rng: &mut Pcg32,
+    u: (f64, crate::geometry::Vec2),
+    sampler: &mut SampleStream,
     strategy: Strategy,
 ) -> Spectrum {
-    let Some((k, p_select)) = scene.selector.select(rng.next_f64()) else {
+    let Some((k, p_select)) = scene.selector.select(u.0) else {
         return Spectrum::ZERO;
     };
-    let u = rng.next_2d();
+    let u = u.1;
+    let rng = sampler.rng();
     let light = &scene.lights[k];
     let Some(ls) = light.sample(&scene.geometry, hit.p, hit.ng, u) else {
         return Spectrum::ZERO;

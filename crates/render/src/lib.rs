@@ -10,6 +10,8 @@
 //! - [`scene`]: the TOML scene format and its loading (errors with file:line).
 //! - [`camera`], [`film`], [`lights`], [`materials`]: what a scene is made of.
 //! - [`integrator`]: the path tracer (NEE + MIS, Russian roulette).
+//! - [`sampler`]: the pixel samplers (Owen-scrambled Sobol in Morton order, stratified,
+//!   independent) that give each camera sample its random numbers.
 //! - [`render`]: tiles in parallel, passes, interruption, determinism.
 //! - [`partial_film`]: parts of a render for distributed runs, saved exactly and merged.
 
@@ -25,4 +27,5 @@ pub mod lights;
 pub mod materials;
 pub mod partial_film;
 pub mod render;
+pub mod sampler;
 pub mod scene;

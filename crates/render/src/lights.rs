@@ -1,6 +1,8 @@
 //! Lights: point, spot and directional (delta) lights, area lights (emissive shapes) and
 //! the environment (an importance-sampled map, or a constant radiance). Lights are chosen
-//! for next-event estimation in proportion to an estimate of their power.
+//! for next-event estimation by [`LightSelector`]; an area light is
+//! sampled by the solid angle its shape subtends from the shading point
+//! ([`solid_angle_sampling`](crate::geometry::solid_angle_sampling)).
 
 use crate::geometry::{Ray, SceneGeometry, Vec2, Vec3};
 use crate::image::{ConstantEnvironment, EnvironmentMap};
@@ -95,6 +97,11 @@ pub struct LightSample {
 }
 
 impl Light {
+    /// Whether the light is at infinity (the environment, a directional light).
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Directional { .. } | Light::Environment(_))
+    }
+
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
@@ -209,28 +216,25 @@ impl Light {
                 radiance,
                 two_sided,
             } => {
-                let (q, nq, pdf_area) = geometry.sample_shape(*shape, u);
-                if !(pdf_area > 0.0) {
+                let s = geometry.sample_shape_from(*shape, p, u)?;
+                let (q, nq) = (s.point, s.normal);
+                if !(s.pdf > 0.0 && s.pdf.is_finite()) {
                     return None;
                 }
                 let d = q - p;
-                let dist2 = d.length_squared();
-                if dist2 <= 0.0 {
+                let dist = d.length();
+                if !(dist > 0.0) {
                     return None;
                 }
-                let wi = d / dist2.sqrt();
+                let wi = d / dist;
                 let cos_l = nq.dot(-wi);
-                if cos_l <= 0.0 && !two_sided {
-                    return None;
-                }
-                let cos_l = cos_l.abs();
-                if cos_l <= 1e-12 {
+                if (cos_l <= 0.0 && !two_sided) || cos_l.abs() <= 1e-12 {
                     return None;
                 }
                 Some(LightSample {
                     wi,
                     radiance: *radiance,
-                    pdf: pdf_area * dist2 / cos_l,
+                    pdf: s.pdf,
                     delta: false,
                     shadow: Ray::spawn_between(p, ng, q, nq),
                 })
@@ -251,25 +255,26 @@ impl Light {
         }
     }
 
-    /// Solid-angle pdf with which `sample` from `p` produces the direction `wi` that hits
-    /// this (area) light at `q` with normal `nq`.
-    pub fn pdf_area_hit(&self, geometry: &SceneGeometry, p: Vec3, q: Vec3, nq: Vec3) -> f64 {
+    /// Solid-angle pdf with which `sample` from `p` produces the direction that hits this
+    /// (area) light at `q` with normal `nq`, on primitive `prim` of its shape (the triangle
+    /// of a mesh).
+    pub fn pdf_area_hit(
+        &self,
+        geometry: &SceneGeometry,
+        p: Vec3,
+        q: Vec3,
+        nq: Vec3,
+        prim: u32,
+    ) -> f64 {
         match self {
             Light::Area {
                 shape, two_sided, ..
             } => {
-                let d = q - p;
-                let dist2 = d.length_squared();
-                let wi = d / dist2.sqrt();
-                let cos_l = nq.dot(-wi);
+                let cos_l = nq.dot(p - q);
                 if cos_l <= 0.0 && !two_sided {
                     return 0.0;
                 }
-                let area = geometry.shape_area(*shape);
-                if area <= 0.0 || cos_l.abs() <= 1e-12 {
-                    return 0.0;
-                }
-                dist2 / (area * cos_l.abs())
+                geometry.shape_pdf_from(*shape, prim, p, q, nq)
             }
             _ => 0.0,
         }
@@ -295,7 +300,13 @@ impl Light {
     }
 }
 
-/// Picks lights in proportion to their power (uniformly when none has power).
+/// Picks the light for next-event estimation. Lights at a finite distance are picked in
+/// proportion to their power; each light at infinity (the environment, a directional
+/// light) is picked as often as all finite lights together — pbrt-v4's rule for infinite
+/// lights — because their power reaching the scene is not known from the scene's bounding
+/// sphere: the estimate `π r² E` overstates an environment's share in a scene with a large
+/// floor and starves the nearby lights that dominate direct lighting. Lights without power
+/// are never picked (all uniformly when none has power).
 #[derive(Clone, Debug)]
 pub struct LightSelector {
     cdf: Vec<f64>,
@@ -303,11 +314,33 @@ pub struct LightSelector {
 }
 
 impl LightSelector {
-    pub fn new(powers: &[f64]) -> LightSelector {
-        let total: f64 = powers.iter().sum();
+    /// `powers[k]` is light k's power estimate, `infinite[k]` whether it is at infinity.
+    pub fn new(powers: &[f64], infinite: &[bool]) -> LightSelector {
         let n = powers.len();
-        let probs: Vec<f64> = if total > 0.0 && total.is_finite() {
-            powers.iter().map(|p| p / total).collect()
+        let usable = |k: usize| powers[k] > 0.0 && powers[k].is_finite();
+        let finite_total: f64 = (0..n)
+            .filter(|&k| usable(k) && !infinite.get(k).copied().unwrap_or(false))
+            .map(|k| powers[k])
+            .sum();
+        let n_infinite = (0..n)
+            .filter(|&k| usable(k) && infinite.get(k).copied().unwrap_or(false))
+            .count();
+        let finite_group = if finite_total > 0.0 && finite_total.is_finite() {
+            1.0
+        } else {
+            0.0
+        };
+        let groups = n_infinite as f64 + finite_group;
+        let probs: Vec<f64> = if groups > 0.0 {
+            (0..n)
+                .map(
+                    |k| match (usable(k), infinite.get(k).copied().unwrap_or(false)) {
+                        (false, _) => 0.0,
+                        (true, true) => 1.0 / groups,
+                        (true, false) => powers[k] / finite_total / groups,
+                    },
+                )
+                .collect()
         } else {
             vec![1.0 / n.max(1) as f64; n]
         };

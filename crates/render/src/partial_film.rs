@@ -1,6 +1,7 @@
 //! Partial renders for distributed rendering: part K of N renders the sample indices
-//! s ≡ K (mod N) of every pixel (each sample has its own random stream, PCG32 seeded by
-//! (seed, pixel) with stream s, so parts are disjoint and independent of where they run)
+//! s ≡ K (mod N) of every pixel (each sample's random numbers are a pure function of the
+//! seed, the sampler, the pixel and s, so parts are disjoint and independent of where they
+//! run)
 //! and is saved as a `.fcpart` file holding the exact per-pixel f64 sums, squared sums and
 //! sample counts. [`merge_parts`] adds the N parts in part order, so the merged film is
 //! bit for bit the film of [`render_in_parts`] — the same N parts rendered in one process.
@@ -10,11 +11,12 @@
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `FCRPART1` |
-//! | 4 | format version (1) |
+//! | 4 | format version (2; version 1 parts predate the samplers and are refused) |
 //! | 8 | scene hash (FNV-1a of the scene source) |
 //! | 8 | seed |
 //! | 4 + 4 | part K, part count N |
 //! | 4 | samples per pixel of the whole render |
+//! | 4 | sampler: 0 `sobol`, 1 `independent`, 2 `stratified` |
 //! | 4 + 4 | width, height |
 //! | 8 | exposure (f64, stops) |
 //! | 8 | discarded samples |
@@ -23,14 +25,15 @@
 
 use crate::film::Film;
 use crate::render::{render, RenderOptions, RenderStats};
+use crate::sampler::SamplerKind;
 use crate::scene::Scene;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 const MAGIC: &[u8; 8] = b"FCRPART1";
-const VERSION: u32 = 1;
-const HEADER: usize = 8 + 4 + 8 + 8 + 4 + 4 + 4 + 4 + 4 + 8 + 8;
+const VERSION: u32 = 2;
+const HEADER: usize = 8 + 4 + 8 + 8 + 4 + 4 + 4 + 4 + 4 + 4 + 8 + 8;
 const PIXEL: usize = 6 * 8 + 4;
 
 /// Errors of partial files.
@@ -52,6 +55,7 @@ pub struct PartialFilm {
     pub part: u32,
     pub parts: u32,
     pub spp: u32,
+    pub sampler: SamplerKind,
     pub exposure: f64,
     pub film: Film,
 }
@@ -76,8 +80,10 @@ pub fn render_part(
         );
     }
     let spp = opts.spp.unwrap_or(scene.film.spp);
+    let sampler = opts.sampler.unwrap_or(scene.film.sampler);
     let o = RenderOptions {
         spp: Some(spp),
+        sampler: Some(sampler),
         part: Some((part as usize, parts as usize)),
         ..opts.clone()
     };
@@ -92,6 +98,7 @@ pub fn render_part(
             part,
             parts,
             spp: spp as u32,
+            sampler,
             exposure: scene.film.exposure,
             film,
         },
@@ -140,6 +147,13 @@ pub fn merge_parts(parts: &[PartialFilm]) -> Result<Film, PartError> {
         if p.spp != first.spp {
             return Err(what("spp", first.spp.to_string(), p.spp.to_string()));
         }
+        if p.sampler != first.sampler {
+            return Err(what(
+                "the sampler",
+                first.sampler.name().to_string(),
+                p.sampler.name().to_string(),
+            ));
+        }
         if (p.film.width, p.film.height) != (first.film.width, first.film.height) {
             return Err(what(
                 "the image size",
@@ -184,6 +198,14 @@ pub fn merge_parts(parts: &[PartialFilm]) -> Result<Film, PartError> {
     Ok(film)
 }
 
+/// The sampler's code in a part file: its index in [`SamplerKind::NAMES`].
+fn sampler_id(kind: SamplerKind) -> u32 {
+    SamplerKind::NAMES
+        .iter()
+        .position(|n| *n == kind.name())
+        .unwrap_or(0) as u32
+}
+
 impl PartialFilm {
     pub fn to_bytes(&self) -> Vec<u8> {
         let f = &self.film;
@@ -195,6 +217,7 @@ impl PartialFilm {
         out.extend_from_slice(&self.part.to_le_bytes());
         out.extend_from_slice(&self.parts.to_le_bytes());
         out.extend_from_slice(&self.spp.to_le_bytes());
+        out.extend_from_slice(&sampler_id(self.sampler).to_le_bytes());
         out.extend_from_slice(&(f.width as u32).to_le_bytes());
         out.extend_from_slice(&(f.height as u32).to_le_bytes());
         out.extend_from_slice(&self.exposure.to_le_bytes());
@@ -248,6 +271,13 @@ impl PartialFilm {
         let part = u32_(take(4));
         let parts = u32_(take(4));
         let spp = u32_(take(4));
+        let sampler_code = u32_(take(4));
+        let Some(sampler) = SamplerKind::NAMES
+            .get(sampler_code as usize)
+            .and_then(|n| SamplerKind::parse(n))
+        else {
+            return Err(bad(&format!("unknown sampler code {sampler_code}")));
+        };
         let width = u32_(take(4)) as usize;
         let height = u32_(take(4)) as usize;
         let exposure = f64::from_bits(u64_(take(8)));
@@ -294,6 +324,7 @@ impl PartialFilm {
             part,
             parts,
             spp,
+            sampler,
             exposure,
             film,
         })

@@ -1,14 +1,15 @@
 //! Rendering a scene: square tiles in parallel (rayon), in passes of samples so that an
-//! interruption (Ctrl-C, a time limit) leaves every pixel with a valid mean. Each sample has
-//! its own random stream, PCG32 seeded by (seed, pixel) with the sample index as stream, so
-//! the image depends on the seed only — not on the thread count, the tiling or the passes —
-//! and any subset of samples can be rendered separately and merged exactly.
+//! interruption (Ctrl-C, a time limit) leaves every pixel with a valid mean. Each camera
+//! sample's random numbers are a pure function of (seed, pixel, sample index) — the
+//! [`sampler`](crate::sampler)'s stream — so the image depends on the seed and the sampler
+//! only, not on the thread count, the tiling or the passes, and any subset of samples can be
+//! rendered separately and merged exactly.
 
 use crate::film::Film;
 use crate::geometry::Vec2;
 use crate::integrator::{radiance, Strategy};
+use crate::sampler::{PixelSampler, SamplerKind};
 use crate::scene::Scene;
-use facette_bsdf::math::rng::{mix_seed, Pcg32, RandomSource};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -27,6 +28,8 @@ pub struct RenderOptions {
     /// for distributed rendering).
     pub part: Option<(usize, usize)>,
     pub strategy: Strategy,
+    /// The pixel sampler (the scene's when `None`).
+    pub sampler: Option<SamplerKind>,
 }
 
 impl Default for RenderOptions {
@@ -38,6 +41,7 @@ impl Default for RenderOptions {
             time_limit: None,
             part: None,
             strategy: Strategy::Mis,
+            sampler: None,
         }
     }
 }
@@ -148,6 +152,13 @@ fn render_in_pool(
         false
     };
     let diff_scale = 1.0 / (spp as f64).sqrt().max(1.0);
+    let sampler = PixelSampler::new(
+        opts.sampler.unwrap_or(scene.film.sampler),
+        opts.seed,
+        w,
+        h,
+        spp,
+    );
     let mut first = 0;
     for (pass, size) in passes.into_iter().enumerate() {
         let chunk = &indices[first..first + size];
@@ -169,7 +180,6 @@ fn render_in_pool(
                         break;
                     }
                     for x in x0..x1 {
-                        let pixel = (y * w + x) as u64;
                         let mut p = PixelSums {
                             sum: [0.0; 3],
                             sq: [0.0; 3],
@@ -177,14 +187,14 @@ fn render_in_pool(
                             bad: 0,
                         };
                         for &s in chunk {
-                            let mut rng = Pcg32::new(mix_seed(opts.seed, pixel), s as u64);
-                            let off = scene.film.filter.sample(rng.next_2d());
+                            let mut stream = sampler.stream(x, y, s as u64);
+                            let off = scene.film.filter.sample(stream.get_2d());
                             let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
-                            let lens = rng.next_2d();
+                            let lens = stream.get_2d();
                             let (ray, rd) =
                                 scene.camera.generate_ray(fx, fy, Vec2::new(lens.x, lens.y));
                             let rd = rd.scaled(&ray, diff_scale);
-                            let l = radiance(scene, ray, Some(rd), &mut rng, opts.strategy);
+                            let l = radiance(scene, ray, Some(rd), &mut stream, opts.strategy);
                             p.n += 1;
                             if l.is_finite() && !l.has_negative() {
                                 for c in 0..3 {

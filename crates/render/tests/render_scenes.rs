@@ -167,6 +167,12 @@ fn unknown_names_list_the_valid_ones() {
         e.contains("unknown filter `mitchell`; valid: box, gaussian"),
         "{e}"
     );
+    let e = error_of(&format!("{CAMERA}[film]\nsampler = \"halton\"\n"));
+    assert!(
+        e.starts_with("scene.toml:")
+            && e.contains("unknown sampler `halton`; valid: sobol, independent, stratified"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -797,15 +797,19 @@ fn quality_only_parameters_are_warnings_given_once() {
         &scene_xml(
             r#"<shape type="sphere"><point name="center" x="0" y="0" z="4.995"/><float name="radius" value="0.001"/></shape>"#,
         )
-        .replace("type=\"independent\"", "type=\"stratified\"")
-        .replace("</sensor>", "</sensor>\n<sensor type=\"perspective\"><sampler type=\"stratified\"/></sensor>"),
+        .replace("type=\"independent\"", "type=\"multijitter\"")
+        .replace("</sensor>", "</sensor>\n<sensor type=\"perspective\"><sampler type=\"multijitter\"/></sensor>"),
     );
     let sampler: Vec<_> = s
         .warnings
         .iter()
-        .filter(|w| w.contains("sampler `stratified`"))
+        .filter(|w| w.contains("sampler `multijitter` is rendered with facette's `stratified`"))
         .collect();
     assert_eq!(sampler.len(), 1, "{:?}", s.warnings);
+    assert_eq!(
+        s.film.sampler,
+        facette_render::sampler::SamplerKind::Stratified
+    );
     assert!(
         s.warnings.iter().any(|w| w.contains("first <sensor>")),
         "{:?}",
@@ -867,6 +871,7 @@ width = 24
 height = 16
 spp = 4
 filter = "box"
+sampler = "independent"
 [integrator]
 max_depth = 4
 [[objects]]

@@ -24,6 +24,7 @@ use super::bounds::Bounds3;
 use super::error::{GeometryError, GeometryResult};
 use super::interaction::{PrimHit, SurfaceHit};
 use super::ray::Ray;
+use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
 use facette_bsdf::math::warp::square_to_disk_concentric;
@@ -143,6 +144,18 @@ impl Disk {
         let d = square_to_disk_concentric(u);
         let p = self.to_world.point(Vec3::new(d.x, d.y, 0.0));
         (p, self.normal, 1.0 / self.area)
+    }
+
+    /// A point seen from `p`: the area sample converted to solid angle, as pbrt-v4 and
+    /// Mitsuba 3 sample disks (no exact solid-angle sampler of an ellipse is known).
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        area_sample_from(p, self.sample(u))
+    }
+
+    /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
+    /// produces the direction towards the point `q` of the disk.
+    pub fn pdf_from(&self, p: Vec3, q: Vec3) -> f64 {
+        area_to_solid_angle(1.0 / self.area, p, q, self.normal)
     }
 }
 

@@ -7,8 +7,13 @@
 //!   of them.
 //! - [`mesh_io`]: OBJ and PLY files into [`MeshData`]; [`generate`]: procedural meshes.
 //! - [`interaction`]: [`SurfaceHit`] and its screen-space uv derivatives.
+//! - [`solid_angle_sampling`]: sampling a shape as seen from a point (area lights), with
+//!   each shape's best sampler: the sphere's cone, spherical rectangles and triangles.
 //! - [`bvh`]: binned-SAH BVH; [`SceneGeometry`]: all shapes of a scene under one BVH,
 //!   with closest-hit, occlusion and area sampling queries.
+//! - [`spherical_triangle`], [`spherical_rectangle`]: solid angles of triangles and
+//!   rectangles, and directions sampled uniformly in them (Arvo; Ureña, Fajardo and King),
+//!   for next-event estimation towards area lights.
 //!
 //! Everything computes in `f64` (the project's convention); the BVH stores its boxes in
 //! `f32`, rounded outwards.
@@ -31,7 +36,10 @@ pub mod ray;
 pub mod rectangle;
 pub mod scene_geometry;
 pub mod shape;
+pub mod solid_angle_sampling;
 pub mod sphere;
+pub mod spherical_rectangle;
+pub mod spherical_triangle;
 pub mod transform;
 pub mod triangle;
 pub mod triangle_mesh;
@@ -46,6 +54,7 @@ pub use ray::{Ray, RayDifferential};
 pub use rectangle::Rectangle;
 pub use scene_geometry::SceneGeometry;
 pub use shape::Shape;
+pub use solid_angle_sampling::ShapeSample;
 pub use sphere::Sphere;
 pub use transform::Transform;
 pub use triangle_mesh::TriangleMesh;

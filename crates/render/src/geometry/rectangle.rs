@@ -21,6 +21,10 @@ use super::bounds::Bounds3;
 use super::error::{GeometryError, GeometryResult};
 use super::interaction::{PrimHit, SurfaceHit};
 use super::ray::Ray;
+use super::solid_angle_sampling::{
+    area_sample_from, area_to_solid_angle, use_spherical_sampling, ShapeSample,
+};
+use super::spherical_rectangle::SphericalRectangle;
 use super::transform::Transform;
 use super::{Vec2, Vec3};
 
@@ -134,6 +138,38 @@ impl Rectangle {
             .to_world
             .point(Vec3::new(2.0 * u.x - 1.0, 2.0 * u.y - 1.0, 0.0));
         (p, self.normal, 1.0 / self.area)
+    }
+
+    /// The spherical rectangle seen from `p`, where spherical sampling applies: the shape
+    /// is a true rectangle (a shear makes a parallelogram, which the construction does not
+    /// cover) and its solid angle is in the usable range.
+    fn spherical_from(&self, p: Vec3) -> Option<SphericalRectangle> {
+        let corner = self.to_world.point(Vec3::new(-1.0, -1.0, 0.0));
+        let sr = SphericalRectangle::new(p, corner, self.dpdu, self.dpdv)?;
+        use_spherical_sampling(sr.solid_angle()).then_some(sr)
+    }
+
+    /// A point seen from `p`, uniform in the solid angle the rectangle subtends
+    /// (spherical-rectangle sampling, Ureña et al. 2013); area sampling converted to solid
+    /// angle where that does not apply (see [`solid_angle_sampling`](super::solid_angle_sampling)).
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        match self.spherical_from(p) {
+            Some(sr) => sr.sample(u).map(|s| ShapeSample {
+                point: s.point,
+                normal: self.normal,
+                pdf: s.pdf,
+            }),
+            None => area_sample_from(p, self.sample(u)),
+        }
+    }
+
+    /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
+    /// produces the direction towards the point `q` of the rectangle.
+    pub fn pdf_from(&self, p: Vec3, q: Vec3) -> f64 {
+        match self.spherical_from(p) {
+            Some(sr) => 1.0 / sr.solid_angle(),
+            None => area_to_solid_angle(1.0 / self.area, p, q, self.normal),
+        }
     }
 }
 

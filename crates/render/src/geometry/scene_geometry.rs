@@ -6,6 +6,7 @@ use super::error::{GeometryError, GeometryResult};
 use super::interaction::{PrimHit, SurfaceHit};
 use super::ray::Ray;
 use super::shape::Shape;
+use super::solid_angle_sampling::ShapeSample;
 use super::triangle::TriangleRay;
 use super::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -108,6 +109,18 @@ impl SceneGeometry {
             Some(s) => s.sample(u),
             None => (Vec3::ZERO, Vec3::Z, 0.0),
         }
+    }
+
+    /// Shape `id` sampled from the reference point `p` by solid angle
+    /// ([`Shape::sample_from`]); `None` for an unknown id or no sample.
+    pub fn sample_shape_from(&self, id: u32, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        self.shape(id)?.sample_from(p, u)
+    }
+
+    /// Solid-angle density of [`sample_shape_from`](Self::sample_shape_from) at `p` for
+    /// the point `q` (normal `nq`) of primitive `prim` of shape `id`; 0 for an unknown id.
+    pub fn shape_pdf_from(&self, id: u32, prim: u32, p: Vec3, q: Vec3, nq: Vec3) -> f64 {
+        self.shape(id).map_or(0.0, |s| s.pdf_from(p, q, nq, prim))
     }
 
     /// Tests the primitive in `slot` against the ray restricted to `(0, t_max]`.

@@ -5,6 +5,7 @@ use super::disk::Disk;
 use super::interaction::SurfaceHit;
 use super::ray::Ray;
 use super::rectangle::Rectangle;
+use super::solid_angle_sampling::ShapeSample;
 use super::sphere::Sphere;
 use super::triangle_mesh::TriangleMesh;
 use super::{Vec2, Vec3};
@@ -67,6 +68,30 @@ impl Shape {
             Shape::Rectangle(r) => r.sample(u),
             Shape::Disk(d) => d.sample(u),
             Shape::Mesh(m) => m.sample(u),
+        }
+    }
+
+    /// A point of the shape sampled from the reference point `p`, with the density of its
+    /// direction per unit solid angle: each shape's best sampler (see
+    /// [`solid_angle_sampling`](super::solid_angle_sampling)).
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        match self {
+            Shape::Sphere(s) => s.sample_from(p, u),
+            Shape::Rectangle(r) => r.sample_from(p, u),
+            Shape::Disk(d) => d.sample_from(p, u),
+            Shape::Mesh(m) => m.sample_from(p, u),
+        }
+    }
+
+    /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
+    /// produces the direction towards `q` (normal `nq`) on primitive `prim` (the triangle
+    /// of a mesh).
+    pub fn pdf_from(&self, p: Vec3, q: Vec3, nq: Vec3, prim: u32) -> f64 {
+        match self {
+            Shape::Sphere(s) => s.pdf_from(p, q, nq),
+            Shape::Rectangle(r) => r.pdf_from(p, q),
+            Shape::Disk(d) => d.pdf_from(p, q),
+            Shape::Mesh(m) => m.pdf_from(prim as usize, p, q, nq),
         }
     }
 

@@ -27,9 +27,11 @@ use super::bounds::Bounds3;
 use super::error::{GeometryError, GeometryResult};
 use super::interaction::{PrimHit, SurfaceHit};
 use super::ray::Ray;
+use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
 use facette_bsdf::math::warp::square_to_uniform_sphere;
+use facette_bsdf::math::Frame;
 use std::f64::consts::{PI, TAU};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -216,6 +218,73 @@ impl Sphere {
         let p = self.center + self.radius * outward;
         let n = if self.flip_normals { -outward } else { outward };
         (p, n, 1.0 / self.area())
+    }
+
+    /// The cone of directions the sphere subtends from an outside point `p`:
+    /// `(sin² θ_max, 1 − cos θ_max)`, the latter by its Taylor series where the sphere
+    /// is small or far (`1 − cos` of a tiny angle cancels to zero); `None` from inside or
+    /// on the surface.
+    fn cone_from(&self, p: Vec3) -> Option<(f64, f64)> {
+        let dist2 = (self.center - p).length_squared();
+        let r2 = self.radius * self.radius;
+        // On the surface or closer: the cone would be a hemisphere or more.
+        if !(dist2 > r2 * (1.0 + 1e-9)) {
+            return None;
+        }
+        let sin2_max = r2 / dist2;
+        let one_minus_cos_max = if sin2_max < 1e-4 {
+            // 1 − √(1 − x) = x/2 + x²/8 + x³/16 + …; the cubic term is below 1e-13 here.
+            0.5 * sin2_max + 0.125 * sin2_max * sin2_max
+        } else {
+            1.0 - (1.0 - sin2_max).sqrt()
+        };
+        Some((sin2_max, one_minus_cos_max))
+    }
+
+    /// A point of the sphere seen from `p`, its direction uniform in the cone the sphere
+    /// subtends (pdf `1 / (2π (1 − cos θ_max))` per unit solid angle); from inside, a
+    /// uniform area sample converted to solid angle. The cone's direction at angle θ from
+    /// the axis meets the sphere at the point whose angle α at the centre (from the axis
+    /// towards `p`) satisfies `cos α = sin² θ / sin θ_max + cos θ √(1 − sin² θ / sin² θ_max)`
+    /// — the law of sines in the triangle (p, centre, point), written without the
+    /// cancellation a ray–sphere intersection has for far spheres (the form of pbrt-v4's
+    /// `Sphere::Sample(ctx, u)`).
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        let Some((sin2_max, one_minus_cos_max)) = self.cone_from(p) else {
+            return area_sample_from(p, self.sample(u));
+        };
+        // θ uniform in solid angle: 1 − cos θ uniform in [0, 1 − cos θ_max].
+        let one_minus_cos = u.x * one_minus_cos_max;
+        let cos_theta = 1.0 - one_minus_cos;
+        let sin2_theta = one_minus_cos * (2.0 - one_minus_cos);
+        let cos_alpha = sin2_theta / sin2_max.sqrt()
+            + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
+        let cos_alpha = cos_alpha.clamp(-1.0, 1.0);
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
+        let axis = (p - self.center).normalize();
+        let frame = Frame::from_normal(axis);
+        let outward = frame.to_world(Vec3::new(
+            sin_alpha * cos_phi,
+            sin_alpha * sin_phi,
+            cos_alpha,
+        ));
+        let point = self.center + self.radius * outward;
+        let normal = if self.flip_normals { -outward } else { outward };
+        Some(ShapeSample {
+            point,
+            normal,
+            pdf: 1.0 / (TAU * one_minus_cos_max),
+        })
+    }
+
+    /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
+    /// produces the direction towards the surface point `q` (normal `nq`).
+    pub fn pdf_from(&self, p: Vec3, q: Vec3, nq: Vec3) -> f64 {
+        match self.cone_from(p) {
+            Some((_, one_minus_cos_max)) => 1.0 / (TAU * one_minus_cos_max),
+            None => area_to_solid_angle(1.0 / self.area(), p, q, nq),
+        }
     }
 }
 

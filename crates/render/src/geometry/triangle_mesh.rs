@@ -35,6 +35,10 @@ use super::bounds::Bounds3;
 use super::error::{GeometryError, GeometryResult};
 use super::interaction::{PrimHit, SurfaceHit};
 use super::ray::Ray;
+use super::solid_angle_sampling::{
+    area_sample_from, area_to_solid_angle, use_spherical_sampling, ShapeSample,
+};
+use super::spherical_triangle;
 use super::transform::Transform;
 use super::triangle::TriangleRay;
 use super::{Vec2, Vec3};
@@ -311,21 +315,8 @@ impl TriangleMesh {
     /// zero area returns pdf 0.
     pub fn sample(&self, u: Vec2) -> (Vec3, Vec3, f64) {
         let total = self.area();
-        if !(total > 0.0) {
+        let Some((i, ux)) = self.select_triangle(u.x) else {
             return (self.positions[0], Vec3::Z, 0.0);
-        }
-        let target = u.x * total;
-        let i = self
-            .area_cdf
-            .partition_point(|&c| c <= target)
-            .min(self.triangles.len() - 1);
-        let prev = if i == 0 { 0.0 } else { self.area_cdf[i - 1] };
-        let a = self.area_cdf[i] - prev;
-        // Re-use the fraction of u.x within the chosen triangle's interval.
-        let ux = if a > 0.0 {
-            ((target - prev) / a).clamp(0.0, 1.0)
-        } else {
-            0.5
         };
         let [p0, p1, p2] = self.triangle_vertices(i);
         let su = ux.sqrt();
@@ -333,9 +324,79 @@ impl TriangleMesh {
         let b0 = 1.0 - su;
         let b2 = 1.0 - b0 - b1;
         let p = b0 * p0 + b1 * p1 + b2 * p2;
+        (p, self.face_normal(i), 1.0 / total)
+    }
+
+    /// A triangle chosen in proportion to its area by binary search in the cumulative
+    /// areas (O(log n) per sample), and the fraction of `u` within its interval, uniform
+    /// again for the sample inside the triangle. `None` for a mesh of zero area.
+    fn select_triangle(&self, u: f64) -> Option<(usize, f64)> {
+        let total = self.area();
+        if !(total > 0.0) {
+            return None;
+        }
+        let target = u * total;
+        let i = self
+            .area_cdf
+            .partition_point(|&c| c <= target)
+            .min(self.triangles.len() - 1);
+        let prev = if i == 0 { 0.0 } else { self.area_cdf[i - 1] };
+        let a = self.area_cdf[i] - prev;
+        let rest = if a > 0.0 {
+            ((target - prev) / a).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        Some((i, rest))
+    }
+
+    /// The geometric normal of triangle `i` as a hit reports it (`flip_normals` applied).
+    fn face_normal(&self, i: usize) -> Vec3 {
+        let [p0, p1, p2] = self.triangle_vertices(i);
         let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        let n = if self.flip_normals { -n } else { n };
-        (p, n, 1.0 / total)
+        if self.flip_normals {
+            -n
+        } else {
+            n
+        }
+    }
+
+    /// The solid angle triangle `i` subtends from `p` when spherical-triangle sampling
+    /// applies to it, else `None` (area sampling).
+    fn spherical_solid_angle(&self, i: usize, p: Vec3) -> Option<f64> {
+        let omega = spherical_triangle::solid_angle(p, self.triangle_vertices(i));
+        use_spherical_sampling(omega).then_some(omega)
+    }
+
+    /// A point seen from `p`: a triangle chosen in proportion to its area, then a
+    /// direction uniform in the solid angle it subtends (Arvo 1995), or its area sample
+    /// converted to solid angle where spherical sampling does not apply (see
+    /// [`solid_angle_sampling`](super::solid_angle_sampling)).
+    pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        let (i, ux) = self.select_triangle(u.x)?;
+        let select = self.triangle_area(i) / self.area();
+        let Some(omega) = self.spherical_solid_angle(i, p) else {
+            return area_sample_from(p, self.sample(u));
+        };
+        let s = spherical_triangle::sample(p, self.triangle_vertices(i), Vec2::new(ux, u.y))?;
+        Some(ShapeSample {
+            point: s.point,
+            normal: self.face_normal(i),
+            pdf: select / omega,
+        })
+    }
+
+    /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
+    /// produces the direction towards the point `q` of triangle `i` (normal `nq`).
+    pub fn pdf_from(&self, i: usize, p: Vec3, q: Vec3, nq: Vec3) -> f64 {
+        let total = self.area();
+        if i >= self.triangles.len() || !(total > 0.0) {
+            return 0.0;
+        }
+        match self.spherical_solid_angle(i, p) {
+            Some(omega) => self.triangle_area(i) / total / omega,
+            None => area_to_solid_angle(1.0 / total, p, q, nq),
+        }
     }
 }
 

@@ -17,6 +17,10 @@ fn default_fov() -> f64 {
 fn default_size() -> usize {
     512
 }
+fn default_sampler() -> String {
+    crate::sampler::SamplerKind::default().name().to_string()
+}
+
 fn default_spp() -> usize {
     16
 }
@@ -92,6 +96,9 @@ pub struct FilmDesc {
     /// Exposure in stops applied when writing.
     #[serde(default)]
     pub exposure: f64,
+    /// The pixel sampler: `sobol`, `independent` or `stratified`.
+    #[serde(default = "default_sampler")]
+    pub sampler: String,
 }
 
 impl Default for FilmDesc {
@@ -104,6 +111,7 @@ impl Default for FilmDesc {
             filter_stddev: default_stddev(),
             filter_radius: default_radius(),
             exposure: 0.0,
+            sampler: default_sampler(),
         }
     }
 }

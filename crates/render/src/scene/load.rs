@@ -16,6 +16,7 @@ use crate::image::{
 };
 use crate::lights::{Environment, Light, LightSelector};
 use crate::materials::SceneMaterial;
+use crate::sampler::SamplerKind;
 use facette_bsdf::Spectrum;
 use glam::DMat3;
 use std::collections::BTreeMap;
@@ -241,12 +242,23 @@ pub(crate) fn build(ctx: &Ctx, desc: SceneDesc, source_hash: u64) -> Result<Scen
             ));
         }
     };
+    let Some(sampler) = SamplerKind::parse(&f.sampler) else {
+        return Err(ctx.err(
+            film_span,
+            format!(
+                "unknown sampler `{}`; valid: {}",
+                f.sampler,
+                SamplerKind::NAMES.join(", ")
+            ),
+        ));
+    };
     let film = FilmSettings {
         width: f.width,
         height: f.height,
         spp: f.spp,
         filter,
         exposure: f.exposure,
+        sampler,
     };
     let integ_span = desc.integrator.as_ref().map(|i| i.span());
     let i = desc.integrator.map(|i| i.into_inner()).unwrap_or_default();
@@ -638,7 +650,8 @@ pub(crate) fn build(ctx: &Ctx, desc: SceneDesc, source_hash: u64) -> Result<Scen
         0.5 * b.extent().length().max(1e-3)
     };
     let powers: Vec<f64> = lights.iter().map(|l| l.power(&geometry, radius)).collect();
-    let selector = LightSelector::new(&powers);
+    let infinite: Vec<bool> = lights.iter().map(Light::is_infinite).collect();
+    let selector = LightSelector::new(&powers, &infinite);
     Ok(Scene {
         geometry,
         shape_material,

@@ -15,6 +15,7 @@ use crate::film::Filter;
 use crate::geometry::SceneGeometry;
 use crate::lights::{Light, LightSelector};
 use crate::materials::SceneMaterial;
+use crate::sampler::SamplerKind;
 
 /// Film settings of a scene.
 #[derive(Clone, Debug)]
@@ -24,6 +25,7 @@ pub struct FilmSettings {
     pub spp: usize,
     pub filter: Filter,
     pub exposure: f64,
+    pub sampler: SamplerKind,
 }
 
 /// Path-tracer settings, in Mitsuba's convention: `max_depth` is the longest path length

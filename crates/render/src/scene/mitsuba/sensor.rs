@@ -7,7 +7,7 @@
 //! | `thinlens` (+ `aperture_radius`, `focus_distance` 10⁴) | `aperture_radius`, `focus_distance` |
 //! | `hdrfilm` (`width` 768, `height` 576, `rfilter`) | film size |
 //! | `rfilter` `box`; `gaussian` (`stddev` 0.5, radius 4 σ) | `box`; `gaussian` with `filter_stddev`, `filter_radius = 4 σ` |
-//! | `sampler` (`sample_count` 4; any type) | `spp` (a sampler type other than `independent` is a warning: facette has its own) |
+//! | `sampler` (`sample_count` 4) | `spp`, and the nearest of facette's samplers: `independent` → `independent`; `stratified`, `multijitter` → `stratified`; `ldsampler`, `orthogonal` → `sobol` (a warning says so); other parameters (`seed`, `jitter`, `strength`, …) are ignored with a warning |
 //!
 //! facette has no clipping planes: `near_clip`/`far_clip` are checked against the scene
 //! after it is built, with a warning when they would have hidden geometry
@@ -18,6 +18,7 @@ use super::translator::Translator;
 use super::xml::Pos;
 use crate::camera::FovAxis;
 use crate::geometry::{Transform, Vec2, Vec3};
+use crate::sampler::SamplerKind;
 use crate::scene::description::{CameraDesc, FilmDesc};
 use crate::scene::{Scene, SceneError};
 use glam::{DMat3, DMat4, DVec3};
@@ -59,9 +60,9 @@ pub(crate) fn sensor(
         },
     };
     let mut film = film;
-    film.spp = match s.object("sampler", &cx.reg)? {
+    (film.spp, film.sampler) = match s.object("sampler", &cx.reg)? {
         Some(smp) => sampler(cx, &smp)?,
-        None => DEFAULT_SPP,
+        None => (DEFAULT_SPP, SamplerKind::Independent.name().to_string()),
     };
 
     let m = s.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
@@ -243,14 +244,29 @@ fn film(cx: &mut Translator, f: &Plugin) -> Result<FilmDesc, SceneError> {
     Ok(film)
 }
 
-/// The sample count; everything else about a sampler only changes the noise.
-fn sampler(cx: &mut Translator, s: &Plugin) -> Result<usize, SceneError> {
-    if s.kind != "independent" {
+/// The sample count and the nearest of facette's samplers; the sampler's other
+/// parameters only change the noise. Mitsuba's `independent` and `stratified` are
+/// facette's; `multijitter` (jittered strata) becomes `stratified`; `ldsampler` and
+/// `orthogonal` (low-discrepancy points, stratified in every 2D projection) become
+/// `sobol`.
+fn sampler(cx: &mut Translator, s: &Plugin) -> Result<(usize, String), SceneError> {
+    let kind = match s.kind.as_str() {
+        "independent" => SamplerKind::Independent,
+        "stratified" | "multijitter" => SamplerKind::Stratified,
+        "ldsampler" | "orthogonal" => SamplerKind::Sobol,
+        other => {
+            return Err(s.err(format!(
+                "unsupported sampler `{other}`; supported: independent, stratified, multijitter, ldsampler, orthogonal"
+            )))
+        }
+    };
+    if s.kind != kind.name() {
         cx.warn(
             &s.pos,
             format!(
-                "sampler `{}`: facette draws its own independent samples (PCG32 streams); only sample_count is used",
-                s.kind
+                "sampler `{}` is rendered with facette's `{}` sampler",
+                s.kind,
+                kind.name()
             ),
         );
     }
@@ -271,7 +287,7 @@ fn sampler(cx: &mut Translator, s: &Plugin) -> Result<usize, SceneError> {
         }
     }
     s.finish(&["sample_count"], &cx.reg)?;
-    Ok(n as usize)
+    Ok((n as usize, kind.name().to_string()))
 }
 
 impl ClipPlanes {
