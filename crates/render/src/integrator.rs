@@ -125,18 +125,19 @@ pub fn radiance(
         let frame = hit.shading_frame();
         let wo = frame.to_local(-ray.dir);
         let flags = bsdf.flags();
-        sampler.set_dimension(CAMERA_DIMENSIONS + (segment - 1) * VERTEX_DIMENSIONS);
-        // Next-event estimation (its dimensions are taken whether or not it runs).
-        let light_choice = sampler.get_1d();
-        let light_position = sampler.get_2d();
+        // This vertex's block of dimensions; a decision that is not taken (no light
+        // sampling from a delta BSDF, no roulette yet) leaves its dimensions undrawn.
+        let block = CAMERA_DIMENSIONS + (segment - 1) * VERTEX_DIMENSIONS;
+        // Next-event estimation.
         if flags.has_smooth_part() && strategy != Strategy::BsdfOnly {
-            let u = (light_choice, light_position);
+            sampler.set_dimension(block);
+            let u = (sampler.get_1d(), sampler.get_2d());
             l += beta * sample_light(scene, &hit, &frame, wo, &*bsdf, u, sampler, strategy);
         }
         // Continue by BSDF sampling.
+        sampler.set_dimension(block + 3);
         let lobe = sampler.get_1d();
         let direction = sampler.get_2d();
-        let roulette = sampler.get_1d();
         let mut source = PrefixedSource::new(lobe, direction, sampler.rng());
         let Some(s) = bsdf.sample(wo, &ctx, &mut source) else {
             break;
@@ -155,7 +156,8 @@ pub fn radiance(
         segment += 1;
         if segment > settings.rr_depth {
             let q = (beta.max_component() * eta_scale).min(0.95);
-            if !(q > 0.0) || roulette >= q {
+            sampler.set_dimension(block + 6);
+            if !(q > 0.0) || sampler.get_1d() >= q {
                 break;
             }
             beta /= q;

@@ -372,6 +372,28 @@ fn mesh_files_load_with_mitsubas_normals_and_uvs() {
     assert_eq!(mesh(2).triangle_count(), 1);
 }
 
+/// A scene given by a relative path finds the files it names next to itself (once, not
+/// under its directory twice).
+#[test]
+fn files_of_a_scene_given_by_a_relative_path_are_found() {
+    let dir = tempfile::tempdir_in(".").unwrap();
+    write(
+        dir.path(),
+        "tri.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let xml = scene_xml(r#"<shape type="obj"><string name="filename" value="tri.obj"/></shape>"#);
+    write(dir.path(), "scene.xml", &xml);
+    let relative = Path::new(dir.path().file_name().unwrap()).join("scene.xml");
+    assert!(relative.is_relative());
+    let s = load_scene_with(&relative, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(s
+        .geometry
+        .shapes()
+        .iter()
+        .any(|sh| matches!(sh, Shape::Mesh(m) if m.triangle_count() == 1)));
+}
+
 #[test]
 fn emitters_map_to_lights_with_their_values() {
     let dir = tempfile::tempdir().unwrap();

@@ -339,22 +339,28 @@ impl State {
 
 /// A file named in the scene: absolute, or relative to the directory of the file that
 /// names it, then to the main scene file's directory (Mitsuba's file resolver holds the
-/// latter). `None` when neither exists.
+/// latter). `None` when neither exists. The path returned is absolute: the scene builder
+/// resolves relative file names against the scene's directory once more, which would
+/// double a relative directory (`scenes/x/scenes/x/mesh.obj` for a scene given as
+/// `scenes/x/scene.xml`).
 pub(crate) fn resolve(name: &str, from: &Pos, main_dir: &Path) -> Option<PathBuf> {
     let p = Path::new(name);
-    if p.is_absolute() {
-        return p.exists().then(|| p.to_path_buf());
-    }
-    let here = from
-        .file
-        .parent()
-        .map(|d| d.join(p))
-        .unwrap_or_else(|| p.to_path_buf());
-    if here.exists() {
-        return Some(here);
-    }
-    let main = main_dir.join(p);
-    main.exists().then_some(main)
+    let found = if p.is_absolute() {
+        p.exists().then(|| p.to_path_buf())
+    } else {
+        let here = from
+            .file
+            .parent()
+            .map(|d| d.join(p))
+            .unwrap_or_else(|| p.to_path_buf());
+        if here.exists() {
+            Some(here)
+        } else {
+            let main = main_dir.join(p);
+            main.exists().then_some(main)
+        }
+    }?;
+    Some(std::path::absolute(&found).unwrap_or(found))
 }
 
 #[cfg(test)]
