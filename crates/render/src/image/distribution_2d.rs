@@ -7,7 +7,7 @@
 //! [`Distribution2D::pmf`] and [`Distribution2D::sample`] agree to the last bit. The
 //! fractional position inside the chosen cell is returned too, uniformly distributed in
 //! [0, 1)², so a caller can place the sample inside the cell with whatever measure it likes
-//! (the environment map uses it to be uniform in solid angle).
+//! (the environment map draws the position inside a bilinear patch from it).
 //!
 //! CDFs are f64: at 8k×4k cells a float CDF would lose the probabilities of dim cells.
 
