@@ -18,8 +18,9 @@
 //! - [`validation`]: chi-square goodness of fit, normalization, reciprocity, energy and
 //!   NaN sweeps — the checks behind `facette validate` and the test suite.
 //!
-//! Paper references in doc comments use the short names of `../shared/papers/README.md`:
-//! WMLT07, KSK01, IL18, TSBRM, CCM19.
+//! Paper references in doc comments use the short names listed, with full references, in
+//! `docs/references.md`: WMLT07, KSK01, IL18, TSBRM, CCM19 (and HHdD16, KC17, …). "ERRATA N"
+//! refers to erratum N of the numbered errata list in `docs/references.md`.
 
 // `!(x > 0.0)` is used on purpose throughout: it is true for NaN, which must be rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -1,8 +1,9 @@
 //! Tabulated directional albedo of the single-scattering microfacet lobes, E(μ, α) — the data
 //! behind the energy compensation of Kulla & Conty 2017 ("Revisiting physically based shading
 //! at Imageworks", SIGGRAPH course; cited KC17) and Turquin 2019 ("Practical multiple
-//! scattering compensation for microfacet models"; T19). Neither text is among the papers in
-//! `../shared/papers`; the formulas used are restated here and in the compensated models.
+//! scattering compensation for microfacet models"; T19). Neither is one of the five papers
+//! facette implements (full references in `docs/references.md`); the formulas used are
+//! restated here and in the compensated models.
 //!
 //! E(μ_o, α) = ∫ f_ss(o, i) |i·n| dω_i is the energy the single-scattering lobe (the shared
 //! [`SpecularLobe`](crate::microfacet::specular_lobe::SpecularLobe) with its masking) returns

@@ -1,8 +1,9 @@
 //! The Smith microsurface as a random medium: the light transport on which the
 //! multiple-scattering conductor and dielectric are built (Heitz, Hanika, d'Eon & Dachsbacher
 //! 2016, "Multiple-scattering microfacet BSDFs with the Smith model", ACM TOG 35(4) — cited
-//! HHdD16 below). Its text is not among the papers in `../shared/papers`, so the results used
-//! here are restated and derived in this header and cited by section.
+//! HHdD16 below; see `docs/references.md`). It is not one of the five papers facette
+//! implements, so the results used here are restated and derived in this header and cited
+//! by section.
 //!
 //! **Statistics** [HHdD16 §3–4]. The Smith microsurface has uncorrelated heights and slopes:
 //! heights h with density P1 and distribution function C1, normals with the distribution D of
