@@ -530,6 +530,7 @@ def markdown(all_rows, biases, args, sampler_flag, info):
 
 
 def main():
+    global FACETTE
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--spp", type=int, nargs="+", help="test sample counts (default 64)")
     ap.add_argument("--repeats", type=int, help="renders per test (default 3)")
@@ -546,7 +547,11 @@ def main():
     ap.add_argument("--markdown", metavar="FILE", help="also write the Markdown table here")
     ap.add_argument("--write-assets", action="store_true",
                     help="regenerate scenes/efficiency/torus.obj and sky-sun.exr and exit")
+    ap.add_argument("--facette", metavar="BINARY", default=FACETTE,
+                    help="the facette binary to test (default: target/release/facette), e.g."
+                    " an older build to measure a change; cached references are reused")
     args = ap.parse_args()
+    FACETTE = os.path.abspath(args.facette)
     if args.write_assets:
         write_assets()
         return
