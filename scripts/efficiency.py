@@ -321,8 +321,11 @@ class Reference:
 def load_or_render_reference(renderer, name, params, spp, args, sampler_flag, mts):
     d = os.path.join(args.cache, name)
     os.makedirs(d, exist_ok=True)
-    meta_path = os.path.join(d, f"{renderer}.json")
-    files = [os.path.join(d, f"{renderer}-{h}.exr") for h in "ab"]
+    # A facette without --sampler (an older build, --facette) renders its reference with
+    # the XML's sampler: cached apart, so that it never replaces the Sobol reference.
+    tag = renderer if renderer != "facette" or sampler_flag else "facette-default"
+    meta_path = os.path.join(d, f"{tag}.json")
+    files = [os.path.join(d, f"{tag}-{h}.exr") for h in "ab"]
     want = {
         "scene": scene_hash(name),
         "spp": spp,
@@ -549,7 +552,8 @@ def main():
                     help="regenerate scenes/efficiency/torus.obj and sky-sun.exr and exit")
     ap.add_argument("--facette", metavar="BINARY", default=FACETTE,
                     help="the facette binary to test (default: target/release/facette), e.g."
-                    " an older build to measure a change; cached references are reused")
+                    " an older build to measure a change; its cached references are reused,"
+                    " or cached apart when it has no --sampler flag")
     args = ap.parse_args()
     FACETTE = os.path.abspath(args.facette)
     if args.write_assets:
