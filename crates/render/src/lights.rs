@@ -318,13 +318,12 @@ impl LightSelector {
     pub fn new(powers: &[f64], infinite: &[bool]) -> LightSelector {
         let n = powers.len();
         let usable = |k: usize| powers[k] > 0.0 && powers[k].is_finite();
+        let at_infinity = |k: usize| infinite.get(k).copied().unwrap_or(false);
         let finite_total: f64 = (0..n)
-            .filter(|&k| usable(k) && !infinite.get(k).copied().unwrap_or(false))
+            .filter(|&k| usable(k) && !at_infinity(k))
             .map(|k| powers[k])
             .sum();
-        let n_infinite = (0..n)
-            .filter(|&k| usable(k) && infinite.get(k).copied().unwrap_or(false))
-            .count();
+        let n_infinite = (0..n).filter(|&k| usable(k) && at_infinity(k)).count();
         let finite_group = if finite_total > 0.0 && finite_total.is_finite() {
             1.0
         } else {
@@ -333,13 +332,11 @@ impl LightSelector {
         let groups = n_infinite as f64 + finite_group;
         let probs: Vec<f64> = if groups > 0.0 {
             (0..n)
-                .map(
-                    |k| match (usable(k), infinite.get(k).copied().unwrap_or(false)) {
-                        (false, _) => 0.0,
-                        (true, true) => 1.0 / groups,
-                        (true, false) => powers[k] / finite_total / groups,
-                    },
-                )
+                .map(|k| match (usable(k), at_infinity(k)) {
+                    (false, _) => 0.0,
+                    (true, true) => 1.0 / groups,
+                    (true, false) => powers[k] / finite_total / groups,
+                })
                 .collect()
         } else {
             vec![1.0 / n.max(1) as f64; n]
