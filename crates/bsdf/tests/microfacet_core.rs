@@ -1,6 +1,6 @@
 //! The microfacet-core suite (issue: microfacet core): every distribution at roughness
 //! 0.01–1.5 and incidence up to 89°, masking and Fresnel. Fixed seeds; run with
-//! `cargo test --release`.
+//! `cargo test --profile optimized-tests`.
 
 use facette_bsdf::validation::suites::{
     core_suite, distribution_suite, fresnel_checks, masking_checks, Family, SuiteOptions,

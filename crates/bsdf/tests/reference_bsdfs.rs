@@ -1,5 +1,5 @@
 //! The reference-BSDF suite (issue: reference BSDFs): chi-square, consistency, reciprocity,
-//! albedo and NaN sweeps for every model over its grid. Fixed seeds; `cargo test --release`.
+//! albedo and NaN sweeps for every model over its grid. Fixed seeds; `cargo test --profile optimized-tests`.
 
 use facette_bsdf::validation::suites::{
     is_energy_option, material_suite, material_suite_matching, SuiteOptions,

@@ -10,10 +10,15 @@ REPO = pathlib.Path(__file__).resolve().parents[3]
 
 @pytest.fixture(scope="session")
 def facette_bin():
-    """The `facette` binary of this checkout (built by `cargo test --workspace --release`)."""
-    path = os.environ.get("FACETTE_BIN") or str(REPO / "target" / "release" / "facette")
+    """The `facette` binary of this checkout, as the README's test command builds it
+    (`cargo test --workspace --profile optimized-tests`)."""
+    path = os.environ.get("FACETTE_BIN") or str(REPO / "target" / "optimized-tests" / "facette")
     if not os.path.exists(path):
-        subprocess.run(["cargo", "build", "--release", "-p", "facette"], cwd=REPO, check=True)
+        subprocess.run(
+            ["cargo", "build", "--profile", "optimized-tests", "-p", "facette"],
+            cwd=REPO,
+            check=True,
+        )
     return path
 
 

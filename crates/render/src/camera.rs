@@ -121,6 +121,31 @@ impl Camera {
         Vec3::new(sx * self.tan_x, sy * self.tan_y, 1.0)
     }
 
+    /// The world origin of the rays through lens sample `u_lens`, and the world direction
+    /// from it through the local pinhole direction `dl`: every ray through a lens point
+    /// meets its pinhole ray on the focal plane. A pinhole camera uses its origin.
+    #[inline]
+    fn through_lens(&self, u_lens: Vec2) -> (Vec3, impl Fn(Vec3) -> Vec3 + '_) {
+        let lens = (self.lens_radius > 0.0).then(|| {
+            let l = square_to_disk_concentric(u_lens) * self.lens_radius;
+            Vec3::new(l.x, l.y, 0.0)
+        });
+        let origin = lens.map_or(self.origin, |o| self.to_world.point(o));
+        let dir = move |dl: Vec3| match lens {
+            Some(o) => (self.axes * (dl * (self.focus_distance / dl.z) - o)).normalize(),
+            None => (self.axes * dl).normalize(),
+        };
+        (origin, dir)
+    }
+
+    /// The primary ray through film position (x, y), without differentials (for scenes
+    /// whose materials read no texture footprint); the same ray as
+    /// [`generate_ray`](Self::generate_ray)'s.
+    pub fn generate_primary_ray(&self, x: f64, y: f64, u_lens: Vec2) -> Ray {
+        let (o, dir) = self.through_lens(u_lens);
+        Ray::infinite(o, dir(self.local_dir(x, y)))
+    }
+
     /// The primary ray through film position (x, y) and its differentials toward
     /// (x + 1, y) and (x, y + 1); `u_lens` samples the aperture.
     pub fn generate_ray(&self, x: f64, y: f64, u_lens: Vec2) -> (Ray, RayDifferential) {
@@ -128,27 +153,13 @@ impl Camera {
         // One film pixel in local direction space.
         let step_x = Vec3::new(-2.0 * self.tan_x / self.width as f64, 0.0, 0.0);
         let step_y = Vec3::new(0.0, -2.0 * self.tan_y / self.height as f64, 0.0);
-        if self.lens_radius > 0.0 {
-            let lens = square_to_disk_concentric(u_lens) * self.lens_radius;
-            let o = Vec3::new(lens.x, lens.y, 0.0);
-            // Every ray through this lens point meets its pinhole ray on the focal plane.
-            let through = |dl: Vec3| self.axes * (dl * (self.focus_distance / dl.z) - o);
-            let ow = self.to_world.point(o);
-            let ray = Ray::infinite(ow, through(dl).normalize());
-            let rd = RayDifferential {
-                rx_origin: ow,
-                rx_dir: through(dl + step_x).normalize(),
-                ry_origin: ow,
-                ry_dir: through(dl + step_y).normalize(),
-            };
-            return (ray, rd);
-        }
-        let ray = Ray::infinite(self.origin, (self.axes * dl).normalize());
+        let (o, dir) = self.through_lens(u_lens);
+        let ray = Ray::infinite(o, dir(dl));
         let rd = RayDifferential {
-            rx_origin: self.origin,
-            rx_dir: (self.axes * (dl + step_x)).normalize(),
-            ry_origin: self.origin,
-            ry_dir: (self.axes * (dl + step_y)).normalize(),
+            rx_origin: o,
+            rx_dir: dir(dl + step_x),
+            ry_origin: o,
+            ry_dir: dir(dl + step_y),
         };
         (ray, rd)
     }

@@ -20,7 +20,7 @@
 //! interpolated normals). Texture footprints come from the camera ray's differentials at
 //! the first vertex; later vertices point-sample their textures.
 
-use crate::geometry::{Ray, RayDifferential, SurfaceHit, Vec3};
+use crate::geometry::{HitDetail, Ray, RayDifferential, SurfaceHit, Vec3};
 use crate::lights::Light;
 use crate::sampler::{PrefixedSource, SampleStream};
 use crate::scene::Scene;
@@ -74,8 +74,10 @@ pub fn radiance(
     // Segment count: the camera ray is segment 1.
     let mut segment = 1u32;
     loop {
-        let hit = scene.geometry.intersect(&ray);
-        let Some(hit) = hit else {
+        // Untextured materials read no uv: the hit's details are completed only for the
+        // materials that do (textures, glints).
+        let hit = scene.geometry.intersect_with(&ray, HitDetail::Shading);
+        let Some(mut hit) = hit else {
             if let Some(env) = scene.environment {
                 if let Light::Environment(e) = &scene.lights[env as usize] {
                     let le = e.eval(ray.dir);
@@ -114,11 +116,14 @@ pub fn radiance(
         if segment >= settings.max_depth {
             break;
         }
-        let derivs = match (&rd, segment) {
-            (Some(d), 1) => hit.uv_derivatives(d),
-            _ => [0.0; 4],
-        };
         let material = &scene.materials[scene.shape_material[hit.shape as usize] as usize];
+        let mut derivs = [0.0; 4];
+        if material.reads_surface_details() {
+            scene.geometry.complete_hit(&mut hit);
+            if let (Some(d), 1) = (&rd, segment) {
+                derivs = hit.uv_derivatives(d);
+            }
+        }
         let Some(bsdf) = material.bsdf(hit.uv, derivs) else {
             break;
         };

@@ -150,6 +150,13 @@ impl SceneMaterial {
         !self.textures.is_empty()
     }
 
+    /// Whether [`bsdf`](Self::bsdf) reads its `uv` and `derivs` arguments (textures,
+    /// glints): only then does the integrator compute them at a hit.
+    #[inline]
+    pub fn reads_surface_details(&self) -> bool {
+        self.fixed.is_none()
+    }
+
     /// The BSDF at a shading point with texture coordinates `uv` and footprint `derivs`
     /// (`[du/dx, dv/dx, du/dy, dv/dy]`, zeros when unknown): the shared one for an
     /// untextured material (borrowed: no reference-count traffic between threads), a

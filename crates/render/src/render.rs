@@ -152,6 +152,8 @@ fn render_in_pool(
         false
     };
     let diff_scale = 1.0 / (spp as f64).sqrt().max(1.0);
+    // Ray differentials only serve texture and glint footprints.
+    let footprints = scene.materials.iter().any(|m| m.reads_surface_details());
     let sampler = PixelSampler::new(
         opts.sampler.unwrap_or(scene.film.sampler),
         opts.seed,
@@ -191,10 +193,14 @@ fn render_in_pool(
                             let off = scene.film.filter.sample(stream.get_2d());
                             let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
                             let lens = stream.get_2d();
-                            let (ray, rd) =
-                                scene.camera.generate_ray(fx, fy, Vec2::new(lens.x, lens.y));
-                            let rd = rd.scaled(&ray, diff_scale);
-                            let l = radiance(scene, ray, Some(rd), &mut stream, opts.strategy);
+                            let lens = Vec2::new(lens.x, lens.y);
+                            let (ray, rd) = if footprints {
+                                let (ray, rd) = scene.camera.generate_ray(fx, fy, lens);
+                                (ray, Some(rd.scaled(&ray, diff_scale)))
+                            } else {
+                                (scene.camera.generate_primary_ray(fx, fy, lens), None)
+                            };
+                            let l = radiance(scene, ray, rd, &mut stream, opts.strategy);
                             p.n += 1;
                             if l.is_finite() && !l.has_negative() {
                                 for c in 0..3 {

@@ -123,33 +123,71 @@ impl SceneGeometry {
         self.shape(id).map_or(0.0, |s| s.pdf_from(p, q, nq, prim))
     }
 
-    /// Tests the primitive in `slot` against the ray restricted to `(0, t_max]`.
+    /// Tests the primitive in `slot` against the ray restricted to `(0, t_max]`. The
+    /// triangle set-up of the ray (a shear transform) is made at the first triangle the
+    /// ray meets, so scenes of analytic shapes never pay for it.
     #[inline]
-    fn test_prim(&self, slot: usize, ray: &Ray, tri: &TriangleRay, t_max: f64) -> Option<PrimHit> {
+    fn test_prim(
+        &self,
+        slot: usize,
+        ray: &Ray,
+        tri: &mut Option<TriangleRay>,
+        t_max: f64,
+    ) -> Option<PrimHit> {
         let r = self.prims[slot];
         match &self.shapes[r.shape as usize] {
-            Shape::Mesh(m) => m.intersect_triangle(r.prim as usize, tri, t_max),
+            Shape::Mesh(m) => {
+                // Only valid rays get here (`is_valid_query`), for which `new` succeeds.
+                let tri = match tri {
+                    Some(t) => t,
+                    None => tri.insert(TriangleRay::new(ray)?),
+                };
+                m.intersect_triangle(r.prim as usize, tri, t_max)
+            }
             Shape::Sphere(s) => s.intersect_prim(&Ray { t_max, ..*ray }),
             Shape::Rectangle(q) => q.intersect_prim(&Ray { t_max, ..*ray }),
             Shape::Disk(d) => d.intersect_prim(&Ray { t_max, ..*ray }),
         }
     }
 
-    /// The closest hit in `(0, ray.t_max]`, if any. Rays with a zero or non-finite
-    /// direction or origin hit nothing.
+    /// The closest hit in `(0, ray.t_max]`, if any, with every surface detail (uv and its
+    /// derivatives). Rays with a zero or non-finite direction or origin hit nothing.
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceHit> {
-        let tri = TriangleRay::new(ray)?;
+        self.intersect_with(ray, HitDetail::Full)
+    }
+
+    /// The closest hit with the details asked for: [`HitDetail::Shading`] leaves `uv`
+    /// zero and `dpdu`, `dpdv` at their directions only where a shape would need
+    /// transcendental functions for them (the sphere's `acos`/`atan2`), which is all a
+    /// material without textures or glints reads (the shading frame normalizes `dpdu`).
+    /// Complete such a hit later with [`complete_hit`](Self::complete_hit).
+    pub fn intersect_with(&self, ray: &Ray, detail: HitDetail) -> Option<SurfaceHit> {
+        if !is_valid_query(ray) {
+            return None;
+        }
+        let mut tri = None;
         let (_, (slot, hit)) = self.bvh.closest_hit(ray, |slot, t_max| {
-            self.test_prim(slot, ray, &tri, t_max)
+            self.test_prim(slot, ray, &mut tri, t_max)
                 .map(|h| (h.t, (slot, h)))
         })?;
         let r = self.prims[slot];
         Some(match &self.shapes[r.shape as usize] {
             Shape::Mesh(m) => m.surface_hit(ray, r.prim as usize, hit, r.shape),
-            Shape::Sphere(s) => s.surface_hit(ray, hit, r.shape),
+            Shape::Sphere(s) => match detail {
+                HitDetail::Full => s.surface_hit(ray, hit, r.shape),
+                HitDetail::Shading => s.shading_hit(ray, hit, r.shape),
+            },
             Shape::Rectangle(q) => q.surface_hit(ray, hit, r.shape),
             Shape::Disk(d) => d.surface_hit(ray, hit, r.shape),
         })
+    }
+
+    /// Fills in the details [`HitDetail::Shading`] left out, as [`HitDetail::Full`]
+    /// would have computed them.
+    pub fn complete_hit(&self, hit: &mut SurfaceHit) {
+        if let Some(Shape::Sphere(s)) = self.shape(hit.shape) {
+            s.complete_hit(hit);
+        }
     }
 
     /// Whether anything lies on the segment `origin + t·dir`, `0 < t ≤ t_max` (`dir`
@@ -164,13 +202,31 @@ impl SceneGeometry {
 
     /// [`occluded`](Self::occluded) for a prepared ray.
     pub fn occluded_ray(&self, ray: &Ray) -> bool {
-        let Some(tri) = TriangleRay::new(ray) else {
+        if !is_valid_query(ray) {
             return false;
-        };
+        }
+        let mut tri = None;
         self.bvh.any_hit(ray, |slot, t_max| {
-            self.test_prim(slot, ray, &tri, t_max).is_some()
+            self.test_prim(slot, ray, &mut tri, t_max).is_some()
         })
     }
+}
+
+/// Which surface details a closest-hit query computes (Mitsuba 3's ray flags): the
+/// integrator asks only for what the material at the hit reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HitDetail {
+    /// Position, normals and tangent directions: enough to shade an untextured material.
+    Shading,
+    /// Everything, including uv and the magnitudes of dp/du, dp/dv (textures, glints,
+    /// ray-differential footprints).
+    Full,
+}
+
+/// A ray that can hit something: finite origin, finite non-zero direction.
+#[inline]
+fn is_valid_query(ray: &Ray) -> bool {
+    ray.dir.is_finite() && ray.dir != Vec3::ZERO && ray.origin.is_finite()
 }
 
 #[cfg(test)]
@@ -231,6 +287,43 @@ mod tests {
         assert!(s
             .intersect(&Ray::infinite(Vec3::splat(f64::NAN), Vec3::Z))
             .is_none());
+    }
+
+    #[test]
+    fn shading_hits_complete_to_full_hits() {
+        let s = scene();
+        let tilted = Sphere::new(Vec3::new(0.3, -0.2, 0.9), 1.3).unwrap();
+        let far = Sphere::new(Vec3::new(1e4, 2e4, -3e4), 2.0).unwrap();
+        let geometry = SceneGeometry::new(vec![tilted.into(), far.into()]).unwrap();
+        let mut checked = 0;
+        for (g, origin) in [
+            (&s, Vec3::new(0.2, 0.1, 5.0)),
+            (&geometry, Vec3::new(0.2, 0.1, 5.0)),
+            (&geometry, Vec3::new(1e4, 2e4, -3e4 + 10.0)),
+        ] {
+            for k in 0..64 {
+                let (a, b) = ((k % 8) as f64 / 8.0 - 0.45, (k / 8) as f64 / 8.0 - 0.45);
+                let target = origin + Vec3::new(a, b, -1.0) * 4.0;
+                let ray = Ray::infinite(origin, target - origin);
+                let full = g.intersect(&ray);
+                let lean = g.intersect_with(&ray, HitDetail::Shading);
+                assert_eq!(full.is_some(), lean.is_some());
+                let (Some(full), Some(mut lean)) = (full, lean) else {
+                    continue;
+                };
+                assert_eq!(
+                    (full.t, full.p, full.ng, full.ns),
+                    (lean.t, lean.p, lean.ng, lean.ns)
+                );
+                // The shading frame only reads the direction of dp/du.
+                let (ff, fl) = (full.shading_frame(), lean.shading_frame());
+                assert!((ff.s - fl.s).length() < 1e-12, "{:?} {:?}", ff.s, fl.s);
+                g.complete_hit(&mut lean);
+                assert_eq!(full, lean);
+                checked += 1;
+            }
+        }
+        assert!(checked > 80, "{checked}");
     }
 
     #[test]

@@ -159,6 +159,15 @@ impl Sphere {
 
     /// The surface details of a hit found by [`intersect_prim`](Self::intersect_prim).
     pub fn surface_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {
+        let mut h = self.shading_hit(ray, hit, shape);
+        self.complete_hit(&mut h);
+        h
+    }
+
+    /// A hit with `uv` left at zero and `dpdu`, `dpdv` at their directions (not their
+    /// lengths): the frame of an untextured material, without the `acos`/`atan2`/`sqrt` of
+    /// the uv parameterization. [`complete_hit`](Self::complete_hit) fills the rest.
+    pub fn shading_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {
         let outward = (ray.at(hit.t) - self.center).normalize_or_zero();
         let outward = if outward == Vec3::ZERO {
             -ray.dir
@@ -167,19 +176,32 @@ impl Sphere {
         };
         // Re-project onto the surface (Mitsuba does the same) to bound the error of `p`.
         let p = self.center + self.radius * outward;
-        let (uv, dpdu, dpdv) = self.parameterization(outward);
+        let l = self.to_world.inverse_vector(outward);
+        // The directions of the parameterization's dp/du and dp/dv (see `parameterization`).
+        let dpdu = self.to_world.vector(Vec3::new(-l.y, l.x, 0.0));
+        let dpdv = self
+            .to_world
+            .vector(Vec3::new(l.z * l.x, l.z * l.y, -(l.x * l.x + l.y * l.y)));
         let n = if self.flip_normals { -outward } else { outward };
         SurfaceHit {
             t: hit.t,
             p,
             ng: n,
             ns: n,
-            uv,
+            uv: Vec2::ZERO,
             dpdu,
             dpdv,
             shape,
             prim: 0,
         }
+    }
+
+    /// Replaces the tangent directions of a [`shading_hit`](Self::shading_hit) by the
+    /// parameterization's uv, dp/du and dp/dv.
+    pub fn complete_hit(&self, hit: &mut SurfaceHit) {
+        // The geometric normal is the outward direction, up to the flip.
+        let outward = if self.flip_normals { -hit.ng } else { hit.ng };
+        (hit.uv, hit.dpdu, hit.dpdv) = self.parameterization(outward);
     }
 
     /// Hit with shape index 0 (for using a sphere on its own).
