@@ -5,7 +5,8 @@
 //! - Shapes with Mitsuba 3's parameterizations: [`Sphere`], [`Rectangle`], [`Disk`],
 //!   [`TriangleMesh`] (watertight ray–triangle test in [`triangle`]); [`Shape`] holds any
 //!   of them.
-//! - [`mesh_io`]: OBJ and PLY files into [`MeshData`]; [`generate`]: procedural meshes.
+//! - [`mesh_io`]: OBJ and PLY files into [`MeshData`]; [`generate`]: procedural meshes;
+//!   [`vertex_normals`]: Mitsuba's vertex normals for meshes stored without.
 //! - [`interaction`]: [`SurfaceHit`] and its screen-space uv derivatives.
 //! - [`solid_angle_sampling`]: sampling a shape as seen from a point (area lights), with
 //!   each shape's best sampler: the sphere's cone, spherical rectangles and triangles.
@@ -43,6 +44,7 @@ pub mod spherical_triangle;
 pub mod transform;
 pub mod triangle;
 pub mod triangle_mesh;
+pub mod vertex_normals;
 
 pub use bounds::Bounds3;
 pub use bvh::Bvh;
