@@ -4,7 +4,8 @@
 //! - [`transform`]: [`Transform`] (matrix + inverse), Mitsuba's `look_at`.
 //! - Shapes with Mitsuba 3's parameterizations: [`Sphere`], [`Rectangle`], [`Disk`],
 //!   [`TriangleMesh`] (watertight ray–triangle test in [`triangle`]); [`Shape`] holds any
-//!   of them.
+//!   of them. The planar ones (rectangle, disk) share their frame and plane intersection
+//!   (`planar`).
 //! - [`mesh_io`]: OBJ and PLY files into [`MeshData`]; [`generate`]: procedural meshes;
 //!   [`vertex_normals`]: Mitsuba's vertex normals for meshes stored without.
 //! - [`interaction`]: [`SurfaceHit`] and its screen-space uv derivatives.
@@ -33,6 +34,7 @@ pub mod generate;
 pub mod interaction;
 pub mod mesh_data;
 pub mod mesh_io;
+mod planar;
 pub mod ray;
 pub mod rectangle;
 pub mod scene_geometry;
