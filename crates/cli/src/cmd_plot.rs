@@ -239,7 +239,7 @@ fn finish(chart: &LineChart, output: &Path, csv: &Option<PathBuf>) -> Result<()>
     }
     save_figure(chart, output)?;
     if let Some(p) = csv {
-        facette_lab::atomic_file::write_atomically(p, chart_csv(chart).as_bytes())
+        facette_bsdf::storage::atomic_file::write_atomically(p, chart_csv(chart).as_bytes())
             .with_context(|| format!("cannot write {}", p.display()))?;
     }
     println!("wrote {}", output.display());
@@ -257,7 +257,7 @@ fn save_map(map: &HemisphereMap, output: &Path, csv: &Option<PathBuf>) -> Result
                 s += &format!("{x:.6},{y:.6},{v:.9e}\n");
             }
         }
-        facette_lab::atomic_file::write_atomically(p, s.as_bytes())
+        facette_bsdf::storage::atomic_file::write_atomically(p, s.as_bytes())
             .with_context(|| format!("cannot write {}", p.display()))?;
     }
     println!("wrote {}", output.display());
@@ -281,8 +281,11 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
             let chart = polar_from_slice(slice, &o);
             save_figure(&chart, &s.m.output)?;
             if let Some(p) = &s.m.csv {
-                facette_lab::atomic_file::write_atomically(p, chart_csv(&chart).as_bytes())
-                    .with_context(|| format!("cannot write {}", p.display()))?;
+                facette_bsdf::storage::atomic_file::write_atomically(
+                    p,
+                    chart_csv(&chart).as_bytes(),
+                )
+                .with_context(|| format!("cannot write {}", p.display()))?;
             }
             println!("wrote {}", s.m.output.display());
         }
