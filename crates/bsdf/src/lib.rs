@@ -15,6 +15,8 @@
 //! - [`models`]: one file per model.
 //! - [`spec`]: materials written as TOML tables (`{type = "dielectric", …}`), validated and
 //!   built into BSDFs.
+//! - [`storage`]: the atomic file writer and the framed binary container that every
+//!   file facette writes goes through.
 //! - [`validation`]: chi-square goodness of fit, normalization, reciprocity, energy and
 //!   NaN sweeps — the checks behind `facette validate` and the test suite.
 //!
@@ -32,6 +34,7 @@ pub mod math;
 pub mod microfacet;
 pub mod models;
 pub mod spec;
+pub mod storage;
 
 pub mod validation;
 

@@ -238,7 +238,7 @@ fn tables_interpolate_the_quadrature_and_round_trip_through_files() {
     let e = BodyTable::from_bytes(&bytes[..40], "x.fctab")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("checksum") || e.contains("magic"), "{e}");
+    assert!(e.contains("truncated"), "{e}");
     let e = BodyTable::from_bytes(b"not a table at all, just text", "x.fctab")
         .unwrap_err()
         .to_string();

@@ -59,7 +59,7 @@ pub fn run(a: IlApproxArgs) -> Result<ExitCode> {
             }
             let src = coefficients_source(&fits, samples);
             match output {
-                Some(p) => std::fs::write(&p, src)
+                Some(p) => facette_bsdf::storage::atomic_file::write_atomically(&p, src.as_bytes())
                     .with_context(|| format!("cannot write {}", p.display()))?,
                 None => print!("{src}"),
             }

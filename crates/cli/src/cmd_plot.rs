@@ -239,7 +239,7 @@ fn finish(chart: &LineChart, output: &Path, csv: &Option<PathBuf>) -> Result<()>
     }
     save_figure(chart, output)?;
     if let Some(p) = csv {
-        facette_lab::atomic_file::write_atomically(p, chart_csv(chart).as_bytes())
+        facette_bsdf::storage::atomic_file::write_atomically(p, chart_csv(chart).as_bytes())
             .with_context(|| format!("cannot write {}", p.display()))?;
     }
     println!("wrote {}", output.display());
@@ -257,7 +257,7 @@ fn save_map(map: &HemisphereMap, output: &Path, csv: &Option<PathBuf>) -> Result
                 s += &format!("{x:.6},{y:.6},{v:.9e}\n");
             }
         }
-        facette_lab::atomic_file::write_atomically(p, s.as_bytes())
+        facette_bsdf::storage::atomic_file::write_atomically(p, s.as_bytes())
             .with_context(|| format!("cannot write {}", p.display()))?;
     }
     println!("wrote {}", output.display());
@@ -271,21 +271,7 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
             let chart = slice_chart(&mats, &slice_options(&s)?);
             finish(&chart, &s.m.output, &s.m.csv)?;
         }
-        PlotKind::Polar(s) => {
-            let mats = materials(&s.m)?;
-            let o = slice_options(&s)?;
-            let slice = slice_chart(&mats, &o);
-            for line in summarize(&slice) {
-                println!("{line}");
-            }
-            let chart = polar_from_slice(slice, &o);
-            save_figure(&chart, &s.m.output)?;
-            if let Some(p) = &s.m.csv {
-                facette_lab::atomic_file::write_atomically(p, chart_csv(&chart).as_bytes())
-                    .with_context(|| format!("cannot write {}", p.display()))?;
-            }
-            println!("wrote {}", s.m.output.display());
-        }
+        PlotKind::Polar(s) => plot_polar(&s)?,
         PlotKind::Hemisphere {
             m,
             theta_i,
@@ -293,38 +279,7 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
             channel,
             log,
             resolution,
-        } => {
-            check_theta(theta_i)?;
-            if !(8..=512).contains(&resolution) {
-                bail!("--resolution {resolution}: expected 8…512 cells");
-            }
-            let mats = materials(&m)?;
-            if mats.len() != 1 {
-                bail!("a hemisphere map shows one material; got {}", mats.len());
-            }
-            let map = hemisphere_chart(
-                &mats[0],
-                theta_i,
-                parse_choice("--quantity", &quantity, Quantity::parse, Quantity::NAMES)?,
-                parse_choice("--channel", &channel, Channel::parse, Channel::NAMES)?,
-                if log { Scale::Log } else { Scale::Linear },
-                resolution,
-                m.samples,
-                m.seed,
-            );
-            map.value_range()?;
-            let vals = map
-                .values
-                .iter()
-                .flatten()
-                .copied()
-                .filter(|v| v.is_finite());
-            let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-            println!("hemisphere map, θ_i = {theta_i}°: min {lo:.6e}, max {hi:.6e}");
-            save_map(&map, &m.output, &m.csv)?;
-        }
+        } => plot_hemisphere(&m, theta_i, &quantity, &channel, log, resolution)?,
         PlotKind::Ndf {
             material,
             footprint,
@@ -333,45 +288,16 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
             supersample,
             output,
             csv,
-        } => {
-            if !(8..=512).contains(&resolution) {
-                bail!("--resolution {resolution}: expected 8…512 cells");
-            }
-            if !(1..=16).contains(&supersample) {
-                bail!("--supersample {supersample}: expected 1…16 points per cell side");
-            }
-            Format::of(&output)?;
-            let bsdf = parse_glint_at(&material, footprint.as_deref())?;
-            let fp = bsdf.query();
-            let title = format!(
-                "D_P of {} — footprint centre ({:.1}, {:.1}) texels",
-                bsdf.surface().label(),
-                fp.center.x,
-                fp.center.y
-            );
-            let mut m = patch_ndf_map(&bsdf, title, resolution, supersample);
-            m.map.scale = if log { Scale::Log } else { Scale::Linear };
-            m.map.value_range()?;
-            println!("{}", facette_bsdf::Bsdf::describe(&bsdf));
-            println!(
-                "patch NDF map ({resolution}² cells, {supersample}² points each): max {:.6e} 1/sr, ∫ D_P cos θ_h dω_h ≈ {:.4}",
-                m.max, m.integral
-            );
-            save_map(&m.map, &output, &csv)?;
-        }
-        PlotKind::Albedo { m, step } => {
-            if !(0.5..=45.0).contains(&step) {
-                bail!("--step {step}: expected 0.5…45 degrees");
-            }
-            let mats = materials(&m)?;
-            let n = (89.0 / step).floor() as usize;
-            let mut thetas: Vec<f64> = (0..=n).map(|k| k as f64 * step).collect();
-            if *thetas.last().expect("non-empty") < 89.0 {
-                thetas.push(89.0);
-            }
-            let chart = albedo_chart(&mats, &thetas, m.samples.max(1000), m.seed);
-            finish(&chart, &m.output, &m.csv)?;
-        }
+        } => plot_ndf(
+            &material,
+            footprint.as_deref(),
+            log,
+            resolution,
+            supersample,
+            &output,
+            &csv,
+        )?,
+        PlotKind::Albedo { m, step } => plot_albedo(&m, step)?,
         PlotKind::Table {
             material,
             table,
@@ -380,46 +306,165 @@ pub fn run(a: PlotArgs) -> Result<ExitCode> {
             points,
             output,
             csv,
-        } => {
-            check_theta(theta_i)?;
-            Format::of(&output)?;
-            let t = parse_inline_table(&material).context("--material")?;
-            let recipe =
-                MaterialRecipe::parse(&t, std::path::Path::new(".")).context("--material")?;
-            let MaterialRecipe::Il {
-                kd,
-                ni,
-                lobe: Some(lobe),
-                ..
-            } = recipe
-            else {
-                bail!("--material: `plot table` needs a rough interfaced-Lambertian material (type = \"il\" with a roughness)");
-            };
-            let body = Arc::new(
-                BodyTable::load(&table).with_context(|| format!("--table {}", table.display()))?,
-            );
-            let tabled = InterfacedLambertian::new(
-                kd,
-                ni,
-                Some(lobe.clone()),
-                BodyEvaluation::Table(body.clone()),
-                Scattering::Single,
-            )
-            .with_context(|| format!("--table {} does not match --material", table.display()))?;
-            let quad = InterfacedLambertian::new(
-                kd,
-                ni,
-                Some(lobe),
-                BodyEvaluation::Quadrature { samples },
-                Scattering::Single,
-            )?;
-            let cmp = compare_table(&body, &tabled, &quad, theta_i, points.max(2));
-            println!(
-                "table vs quadrature at θ_i = {theta_i}°, |θ_o| ≤ 80°: interpolated mean relative error {:.3e}, max {:.3e}; nearest entry mean {:.3e}, max {:.3e}",
-                cmp.interpolated_error.0, cmp.interpolated_error.1, cmp.nearest_error.0, cmp.nearest_error.1
-            );
-            finish(&cmp.chart, &output, &csv)?;
-        }
+        } => plot_table(&material, &table, theta_i, samples, points, &output, &csv)?,
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `plot polar`: the slice drawn in polar form, with its summary lines.
+fn plot_polar(s: &SliceArgs) -> Result<()> {
+    let mats = materials(&s.m)?;
+    let o = slice_options(s)?;
+    let slice = slice_chart(&mats, &o);
+    for line in summarize(&slice) {
+        println!("{line}");
+    }
+    let chart = polar_from_slice(slice, &o);
+    save_figure(&chart, &s.m.output)?;
+    if let Some(p) = &s.m.csv {
+        facette_bsdf::storage::atomic_file::write_atomically(p, chart_csv(&chart).as_bytes())
+            .with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    println!("wrote {}", s.m.output.display());
+    Ok(())
+}
+
+/// `plot hemisphere`: one material's values over the outgoing hemisphere.
+fn plot_hemisphere(
+    m: &MaterialsArgs,
+    theta_i: f64,
+    quantity: &str,
+    channel: &str,
+    log: bool,
+    resolution: usize,
+) -> Result<()> {
+    check_theta(theta_i)?;
+    if !(8..=512).contains(&resolution) {
+        bail!("--resolution {resolution}: expected 8…512 cells");
+    }
+    let mats = materials(m)?;
+    if mats.len() != 1 {
+        bail!("a hemisphere map shows one material; got {}", mats.len());
+    }
+    let map = hemisphere_chart(
+        &mats[0],
+        theta_i,
+        parse_choice("--quantity", quantity, Quantity::parse, Quantity::NAMES)?,
+        parse_choice("--channel", channel, Channel::parse, Channel::NAMES)?,
+        if log { Scale::Log } else { Scale::Linear },
+        resolution,
+        m.samples,
+        m.seed,
+    );
+    map.value_range()?;
+    let vals = map
+        .values
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite());
+    let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    println!("hemisphere map, θ_i = {theta_i}°: min {lo:.6e}, max {hi:.6e}");
+    save_map(&map, &m.output, &m.csv)
+}
+
+/// `plot ndf`: the patch NDF of one glint footprint.
+fn plot_ndf(
+    material: &str,
+    footprint: Option<&str>,
+    log: bool,
+    resolution: usize,
+    supersample: usize,
+    output: &Path,
+    csv: &Option<PathBuf>,
+) -> Result<()> {
+    if !(8..=512).contains(&resolution) {
+        bail!("--resolution {resolution}: expected 8…512 cells");
+    }
+    if !(1..=16).contains(&supersample) {
+        bail!("--supersample {supersample}: expected 1…16 points per cell side");
+    }
+    Format::of(output)?;
+    let bsdf = parse_glint_at(material, footprint)?;
+    let fp = bsdf.query();
+    let title = format!(
+        "D_P of {} — footprint centre ({:.1}, {:.1}) texels",
+        bsdf.surface().label(),
+        fp.center.x,
+        fp.center.y
+    );
+    let mut m = patch_ndf_map(&bsdf, title, resolution, supersample);
+    m.map.scale = if log { Scale::Log } else { Scale::Linear };
+    m.map.value_range()?;
+    println!("{}", facette_bsdf::Bsdf::describe(&bsdf));
+    println!(
+        "patch NDF map ({resolution}² cells, {supersample}² points each): max {:.6e} 1/sr, ∫ D_P cos θ_h dω_h ≈ {:.4}",
+        m.max, m.integral
+    );
+    save_map(&m.map, output, csv)
+}
+
+/// `plot albedo`: directional albedo against θ_i, every `step` degrees up to 89°.
+fn plot_albedo(m: &MaterialsArgs, step: f64) -> Result<()> {
+    if !(0.5..=45.0).contains(&step) {
+        bail!("--step {step}: expected 0.5…45 degrees");
+    }
+    let mats = materials(m)?;
+    let n = (89.0 / step).floor() as usize;
+    let mut thetas: Vec<f64> = (0..=n).map(|k| k as f64 * step).collect();
+    if *thetas.last().expect("non-empty") < 89.0 {
+        thetas.push(89.0);
+    }
+    let chart = albedo_chart(&mats, &thetas, m.samples.max(1000), m.seed);
+    finish(&chart, &m.output, &m.csv)
+}
+
+/// `plot table`: an IL body table against the quadrature it tabulates.
+fn plot_table(
+    material: &str,
+    table: &Path,
+    theta_i: f64,
+    samples: usize,
+    points: usize,
+    output: &Path,
+    csv: &Option<PathBuf>,
+) -> Result<()> {
+    check_theta(theta_i)?;
+    Format::of(output)?;
+    let t = parse_inline_table(material).context("--material")?;
+    let recipe = MaterialRecipe::parse(&t, std::path::Path::new(".")).context("--material")?;
+    let MaterialRecipe::Il {
+        kd,
+        ni,
+        lobe: Some(lobe),
+        ..
+    } = recipe
+    else {
+        bail!("--material: `plot table` needs a rough interfaced-Lambertian material (type = \"il\" with a roughness)");
+    };
+    let body =
+        Arc::new(BodyTable::load(table).with_context(|| format!("--table {}", table.display()))?);
+    let tabled = InterfacedLambertian::new(
+        kd,
+        ni,
+        Some(lobe.clone()),
+        BodyEvaluation::Table(body.clone()),
+        Scattering::Single,
+    )
+    .with_context(|| format!("--table {} does not match --material", table.display()))?;
+    let quad = InterfacedLambertian::new(
+        kd,
+        ni,
+        Some(lobe),
+        BodyEvaluation::Quadrature { samples },
+        Scattering::Single,
+    )?;
+    let cmp = compare_table(&body, &tabled, &quad, theta_i, points.max(2));
+    println!(
+        "table vs quadrature at θ_i = {theta_i}°, |θ_o| ≤ 80°: interpolated mean relative error {:.3e}, max {:.3e}; nearest entry mean {:.3e}, max {:.3e}",
+        cmp.interpolated_error.0, cmp.interpolated_error.1, cmp.nearest_error.0, cmp.nearest_error.1
+    );
+    finish(&cmp.chart, output, csv)
 }

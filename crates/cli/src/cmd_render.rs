@@ -5,9 +5,9 @@
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use facette_render::integrator::Strategy;
-use facette_render::render::{render, RenderOptions};
+use facette_render::render::{render, RenderOptions, RenderStats};
 use facette_render::sampler::SamplerKind;
-use facette_render::scene::{load_scene_with, LoadOptions};
+use facette_render::scene::{load_scene_with, LoadOptions, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -93,41 +93,12 @@ pub fn parse_part(s: &str) -> Result<(u32, u32)> {
 
 pub fn run(a: RenderArgs) -> Result<ExitCode> {
     let part = a.part.as_deref().map(parse_part).transpose()?;
-    let output = a.output.clone().unwrap_or_else(|| {
-        let stem = a
-            .scene
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "render".into());
-        match part {
-            Some((k, n)) => PathBuf::from(format!("{stem}.part{k}of{n}.fcpart")),
-            None => PathBuf::from(stem).with_extension("exr"),
-        }
-    });
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&a.scene, part));
     check_output(&output, part.is_some())?;
-    if part.is_some() && a.time_limit.is_some() {
-        bail!("--time-limit cannot be used with --part: a part must hold all its samples for an exact merge");
-    }
-    if let Some(s) = a.spp {
-        if s == 0 {
-            bail!("--spp must be at least 1");
-        }
-    }
-    if let Some(t) = a.threads {
-        if t == 0 {
-            bail!("--threads must be at least 1");
-        }
-    }
-    if let Some(t) = a.time_limit {
-        if !(t.is_finite() && t > 0.0) {
-            bail!("--time-limit must be a positive number of seconds, got {t}");
-        }
-    }
-    if let Some(e) = a.exposure {
-        if !e.is_finite() {
-            bail!("--exposure must be a finite number of stops, got {e}");
-        }
-    }
+    check_args(&a, part.is_some())?;
 
     let load_start = Instant::now();
     let options = LoadOptions {
@@ -142,34 +113,8 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
     let (w, h) = (scene.film.width, scene.film.height);
 
     let cancel = Arc::new(AtomicBool::new(false));
-    {
-        let cancel = cancel.clone();
-        // A second Ctrl-C exits at once (nothing is written; the previous output stays).
-        let res = ctrlc::set_handler(move || {
-            if cancel.swap(true, Ordering::SeqCst) {
-                eprintln!("\ninterrupted twice: exiting without writing");
-                std::process::exit(130);
-            }
-            eprintln!("\nstopping: finishing the tiles in flight, then writing the image so far (Ctrl-C again to abort)");
-        });
-        if let Err(e) = res {
-            eprintln!(
-                "warning: Ctrl-C handler not installed ({e}); Ctrl-C will abort without writing"
-            );
-        }
-    }
-
-    let pb = ProgressBar::new((w * h * spp) as u64);
-    if a.quiet || !std::io::stderr().is_terminal() {
-        pb.set_draw_target(ProgressDrawTarget::hidden());
-    }
-    pb.set_style(
-        ProgressStyle::with_template(
-            "rendering [{bar:40}] {percent:>3}% {msg} elapsed {elapsed} eta {eta}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
+    install_interrupt_handler(&cancel);
+    let pb = progress_bar((w * h * spp) as u64, a.quiet);
     let start = Instant::now();
     let progress = |done: u64, total: u64| {
         pb.set_length(total);
@@ -220,34 +165,122 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
     facette_render::image::write_image(&output, &image, exposure)
         .with_context(|| format!("writing {}", output.display()))?;
 
-    let empty = film.counts.iter().filter(|&&c| c == 0).count();
     if !a.quiet {
-        let samples = stats.samples;
-        let mean_spp = samples as f64 / (w * h) as f64;
-        let mut line = format!(
-            "{} ({w}×{h}, {} spp{}): scene loaded in {load_secs:.2} s ({} primitives), rendered in {:.2} s, {:.2} Msamples/s, {} discarded samples (NaN/Inf/negative){}",
-            output.display(),
-            if stats.interrupted { format!("{mean_spp:.1} of {spp}") } else { spp.to_string() },
-            if stats.interrupted { ", interrupted" } else { "" },
-            scene.geometry.primitive_count(),
-            stats.seconds,
-            stats.msamples_per_second(),
-            stats.discarded,
-            if empty > 0 { format!(", {empty} pixels without samples (black)") } else { String::new() },
+        let empty = film.counts.iter().filter(|&&c| c == 0).count();
+        eprintln!(
+            "{}",
+            summary(&output, &scene, spp, &stats, load_secs, empty)
         );
-        if stats.discarded > 0 {
-            line.push_str(&format!(
-                " = {:.2e} of all samples",
-                stats.discarded as f64 / samples.max(1) as f64
-            ));
-        }
-        eprintln!("{line}");
     }
     Ok(if cancel.load(Ordering::SeqCst) {
         ExitCode::from(130)
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// The output named after the scene: `STEM.exr`, or `STEM.partKofN.fcpart` for a part.
+fn default_output(scene: &Path, part: Option<(u32, u32)>) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
+    match part {
+        Some((k, n)) => PathBuf::from(format!("{stem}.part{k}of{n}.fcpart")),
+        None => PathBuf::from(stem).with_extension("exr"),
+    }
+}
+
+/// The checks of the numeric options, before the scene is loaded.
+fn check_args(a: &RenderArgs, is_part: bool) -> Result<()> {
+    if is_part && a.time_limit.is_some() {
+        bail!("--time-limit cannot be used with --part: a part must hold all its samples for an exact merge");
+    }
+    if let Some(s) = a.spp {
+        if s == 0 {
+            bail!("--spp must be at least 1");
+        }
+    }
+    if let Some(t) = a.threads {
+        if t == 0 {
+            bail!("--threads must be at least 1");
+        }
+    }
+    if let Some(t) = a.time_limit {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time-limit must be a positive number of seconds, got {t}");
+        }
+    }
+    if let Some(e) = a.exposure {
+        if !e.is_finite() {
+            bail!("--exposure must be a finite number of stops, got {e}");
+        }
+    }
+    Ok(())
+}
+
+/// Ctrl-C sets `cancel` (the render stops after the tiles in flight and writes what it
+/// has); a second Ctrl-C exits at once (nothing is written; the previous output stays).
+fn install_interrupt_handler(cancel: &Arc<AtomicBool>) {
+    let cancel = cancel.clone();
+    let res = ctrlc::set_handler(move || {
+        if cancel.swap(true, Ordering::SeqCst) {
+            eprintln!("\ninterrupted twice: exiting without writing");
+            std::process::exit(130);
+        }
+        eprintln!("\nstopping: finishing the tiles in flight, then writing the image so far (Ctrl-C again to abort)");
+    });
+    if let Err(e) = res {
+        eprintln!("warning: Ctrl-C handler not installed ({e}); Ctrl-C will abort without writing");
+    }
+}
+
+/// The progress bar over `total` samples, hidden when quiet or not on a terminal.
+fn progress_bar(total: u64, quiet: bool) -> ProgressBar {
+    let pb = ProgressBar::new(total);
+    if quiet || !std::io::stderr().is_terminal() {
+        pb.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    pb.set_style(
+        ProgressStyle::with_template(
+            "rendering [{bar:40}] {percent:>3}% {msg} elapsed {elapsed} eta {eta}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    pb
+}
+
+/// The line printed after a render: sizes, samples, times, and what went missing.
+fn summary(
+    output: &Path,
+    scene: &Scene,
+    spp: usize,
+    stats: &RenderStats,
+    load_secs: f64,
+    empty: usize,
+) -> String {
+    let (w, h) = (scene.film.width, scene.film.height);
+    let samples = stats.samples;
+    let mean_spp = samples as f64 / (w * h) as f64;
+    let mut line = format!(
+        "{} ({w}×{h}, {} spp{}): scene loaded in {load_secs:.2} s ({} primitives), rendered in {:.2} s, {:.2} Msamples/s, {} discarded samples (NaN/Inf/negative){}",
+        output.display(),
+        if stats.interrupted { format!("{mean_spp:.1} of {spp}") } else { spp.to_string() },
+        if stats.interrupted { ", interrupted" } else { "" },
+        scene.geometry.primitive_count(),
+        stats.seconds,
+        stats.msamples_per_second(),
+        stats.discarded,
+        if empty > 0 { format!(", {empty} pixels without samples (black)") } else { String::new() },
+    );
+    if stats.discarded > 0 {
+        line.push_str(&format!(
+            " = {:.2e} of all samples",
+            stats.discarded as f64 / samples.max(1) as f64
+        ));
+    }
+    line
 }
 
 /// `NAME=VALUE` of `-D`.

@@ -4,7 +4,6 @@
 //! approximate interfaced-Lambertian body term, plots, the MERL measured-data format,
 //! fitting models to measured data, and the reproductions of the papers' figures.
 
-pub mod atomic_file;
 pub mod figures;
 pub mod fit;
 pub mod il_approx_fit;

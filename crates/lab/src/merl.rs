@@ -19,8 +19,8 @@
 
 #![allow(clippy::needless_range_loop)] // channel loops index the per-channel scales
 
-use crate::atomic_file::write_atomically;
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
+use facette_bsdf::storage::atomic_file::write_atomically;
 use facette_bsdf::{Spectrum, Vec3};
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};

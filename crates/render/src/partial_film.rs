@@ -10,8 +10,12 @@
 //!
 //! | bytes | content |
 //! |---|---|
-//! | 8 | magic `FCRPART1` |
-//! | 4 | format version (2; version 1 parts predate the samplers and are refused) |
+//! A framed file (`facette_bsdf::storage::framed`: magic `FCRPART1`, u32 format version 3,
+//! u64 payload length, payload, CRC-32). Version 2 parts (the same payload, unframed) are
+//! still read; version 1 parts predate the samplers and are refused. The payload:
+//!
+//! | bytes | content |
+//! |---|---|
 //! | 8 | scene hash (FNV-1a of the scene source) |
 //! | 8 | seed |
 //! | 4 + 4 | part K, part count N |
@@ -21,19 +25,24 @@
 //! | 8 | exposure (f64, stops) |
 //! | 8 | discarded samples |
 //! | w·h·(3·8 + 3·8 + 4) | per pixel, row-major from the top: sums R, G, B (f64), squared sums R, G, B (f64), sample count (u32) |
-//! | 4 | CRC-32 of everything before |
 
 use crate::film::Film;
 use crate::render::{render, RenderOptions, RenderStats};
 use crate::sampler::SamplerKind;
 use crate::scene::Scene;
-use std::io::Write;
+use facette_bsdf::storage::atomic_file::write_atomically;
+use facette_bsdf::storage::framed::Framed;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-const MAGIC: &[u8; 8] = b"FCRPART1";
-const VERSION: u32 = 2;
-const HEADER: usize = 8 + 4 + 8 + 8 + 4 + 4 + 4 + 4 + 4 + 4 + 8 + 8;
+const FRAME: Framed = Framed {
+    magic: b"FCRPART1",
+    version: 3,
+    legacy_version: Some(2),
+    what: "facette partial render",
+};
+/// Bytes of the payload before the pixels.
+const HEADER: usize = 8 + 8 + 4 + 4 + 4 + 4 + 4 + 4 + 8 + 8;
 const PIXEL: usize = 6 * 8 + 4;
 
 /// Errors of partial files.
@@ -209,9 +218,7 @@ fn sampler_id(kind: SamplerKind) -> u32 {
 impl PartialFilm {
     pub fn to_bytes(&self) -> Vec<u8> {
         let f = &self.film;
-        let mut out = Vec::with_capacity(HEADER + f.sums.len() * PIXEL + 4);
-        out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
+        let mut out = Vec::with_capacity(HEADER + f.sums.len() * PIXEL);
         out.extend_from_slice(&self.scene_hash.to_le_bytes());
         out.extend_from_slice(&self.seed.to_le_bytes());
         out.extend_from_slice(&self.part.to_le_bytes());
@@ -231,9 +238,7 @@ impl PartialFilm {
             }
             out.extend_from_slice(&f.counts[i].to_le_bytes());
         }
-        let crc = crc32fast::hash(&out);
-        out.extend_from_slice(&crc.to_le_bytes());
-        out
+        FRAME.frame(&out)
     }
 
     /// Parses a part; `path` names it in errors.
@@ -242,17 +247,14 @@ impl PartialFilm {
             path: path.to_path_buf(),
             reason: reason.to_string(),
         };
-        if bytes.len() < 8 || &bytes[..8] != MAGIC {
-            return Err(bad("not a facette partial render (bad magic number)"));
-        }
-        if bytes.len() < HEADER + 4 {
+        let body = FRAME
+            .unframe(bytes)
+            .map_err(|e| bad(&e.to_string()))?
+            .payload;
+        if body.len() < HEADER {
             return Err(bad("truncated header"));
         }
-        let (body, crc) = bytes.split_at(bytes.len() - 4);
-        if crc32fast::hash(body) != u32::from_le_bytes(crc.try_into().expect("4 bytes")) {
-            return Err(bad("checksum mismatch: the file is corrupt or truncated"));
-        }
-        let mut at = 8;
+        let mut at = 0;
         let mut take = |n: usize| {
             let s = &body[at..at + n];
             at += n;
@@ -260,12 +262,6 @@ impl PartialFilm {
         };
         let u32_ = |s: &[u8]| u32::from_le_bytes(s.try_into().expect("4 bytes"));
         let u64_ = |s: &[u8]| u64::from_le_bytes(s.try_into().expect("8 bytes"));
-        let version = u32_(take(4));
-        if version != VERSION {
-            return Err(bad(&format!(
-                "format version {version} is not supported (expected {VERSION})"
-            )));
-        }
         let scene_hash = u64_(take(8));
         let seed = u64_(take(8));
         let part = u32_(take(4));
@@ -344,16 +340,6 @@ impl PartialFilm {
             path: path.to_path_buf(),
             reason,
         };
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let mut tmp = tempfile::NamedTempFile::new_in(dir)
-            .map_err(|e| io(format!("cannot create a temporary file: {e}")))?;
-        tmp.write_all(&self.to_bytes())
-            .map_err(|e| io(e.to_string()))?;
-        tmp.as_file().sync_all().map_err(|e| io(e.to_string()))?;
-        tmp.persist(path).map_err(|e| io(e.error.to_string()))?;
-        Ok(())
+        write_atomically(path, &self.to_bytes()).map_err(|e| io(e.to_string()))
     }
 }

@@ -13,16 +13,17 @@
 //! smooth and each entry carries a standard error; only θ_i ≤ θ_o is computed, the rest by
 //! reciprocity.
 //!
-//! ## File format (`.fctab`, version 1, little-endian)
+//! ## File format (`.fctab`, version 2, little-endian)
+//!
+//! A framed file (`crate::storage::framed`: magic `FCTBODY1`, u32 format version 2, u64
+//! payload length, payload, CRC-32); version 1 files (the same payload, unframed) are
+//! still read. The payload:
 //!
 //! | bytes | content |
 //! |---|---|
-//! | 8 | magic `FCTBODY1` |
-//! | 4 | u32 format version (1) |
 //! | 4 | u32 length L of the header |
 //! | L | UTF-8 TOML header: `model = "il-body"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples`, `max_stderr` and `mean_stderr` (relative standard errors of the entries below the grazing row), `facette_version` |
 //! | 8·n_theta²·n_phi | f64 entries, θ_i-major, then θ_o, then φ |
-//! | 4 | u32 CRC-32 (IEEE) of all preceding bytes |
 
 use super::microfacet_integral::MicrofacetIntegral;
 use crate::error::{ParamError, ParamResult};
@@ -34,8 +35,15 @@ use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Distribution;
 use rayon::prelude::*;
 
-const MAGIC: &[u8; 8] = b"FCTBODY1";
-const VERSION: u32 = 1;
+use crate::storage::atomic_file::write_atomically;
+use crate::storage::framed::Framed;
+
+const FRAME: Framed = Framed {
+    magic: b"FCTBODY1",
+    version: 2,
+    legacy_version: Some(1),
+    what: "facette IL body table",
+};
 
 /// A tabulated IL body integral.
 #[derive(Clone, Debug)]
@@ -195,17 +203,13 @@ impl BodyTable {
     /// Serializes to the documented binary format.
     pub fn to_bytes(&self) -> Vec<u8> {
         let header = self.header();
-        let mut out = Vec::with_capacity(20 + header.len() + 8 * self.data.len());
-        out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
-        out.extend_from_slice(header.as_bytes());
+        let mut payload = Vec::with_capacity(4 + header.len() + 8 * self.data.len());
+        payload.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        payload.extend_from_slice(header.as_bytes());
         for v in &self.data {
-            out.extend_from_slice(&v.to_le_bytes());
+            payload.extend_from_slice(&v.to_le_bytes());
         }
-        let crc = crc32fast::hash(&out);
-        out.extend_from_slice(&crc.to_le_bytes());
-        out
+        FRAME.frame(&payload)
     }
 
     /// Parses the binary format; `path` names the source in errors.
@@ -214,27 +218,18 @@ impl BodyTable {
             path: path.to_string(),
             reason,
         };
-        if bytes.len() < 20 || &bytes[..8] != MAGIC {
-            return Err(bad("not a facette IL body table (bad magic number)".into()));
-        }
-        let crc_stored = u32::from_le_bytes(bytes[bytes.len() - 4..].try_into().unwrap());
-        if crc32fast::hash(&bytes[..bytes.len() - 4]) != crc_stored {
-            return Err(bad(
-                "checksum mismatch: the file is corrupt or truncated".into()
-            ));
-        }
-        let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
-        if version != VERSION {
-            return Err(bad(format!(
-                "format version {version} is not supported (expected {VERSION})"
-            )));
-        }
-        let hlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-        let body = bytes.len() - 4;
-        if 16 + hlen > body {
+        let payload = FRAME
+            .unframe(bytes)
+            .map_err(|e| bad(e.to_string()))?
+            .payload;
+        let Some(hlen) = payload.get(..4) else {
+            return Err(bad("the contents end before the header length".into()));
+        };
+        let hlen = u32::from_le_bytes(hlen.try_into().unwrap()) as usize;
+        if 4 + hlen > payload.len() {
             return Err(bad("header length exceeds the file".into()));
         }
-        let header = std::str::from_utf8(&bytes[16..16 + hlen])
+        let header = std::str::from_utf8(&payload[4..4 + hlen])
             .map_err(|_| bad("header is not UTF-8".into()))?;
         let h: toml::Table =
             toml::from_str(header).map_err(|e| bad(format!("header: {}", e.message())))?;
@@ -263,7 +258,7 @@ impl BodyTable {
             return Err(bad(format!("implausible grid {n_theta} × {n_phi}")));
         }
         let count = n_theta * n_theta * n_phi;
-        let data_bytes = &bytes[16 + hlen..body];
+        let data_bytes = &payload[4 + hlen..];
         if data_bytes.len() != 8 * count {
             return Err(bad(format!(
                 "expected {} bytes of data for a {n_theta}×{n_theta}×{n_phi} grid, found {}",
@@ -309,31 +304,6 @@ impl BodyTable {
             source: e,
         })
     }
-}
-
-/// Writes `bytes` to a temporary file next to `path`, syncs it and renames it over `path`:
-/// a reader never sees a half-written file and a failure leaves the old file in place.
-pub(crate) fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let tmp = dir.join(format!(
-        ".{}.tmp-{}",
-        path.file_name().and_then(|n| n.to_str()).unwrap_or("table"),
-        std::process::id()
-    ));
-    let result = (|| {
-        use std::io::Write;
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 /// The grid and provenance of a table (everything but its values).

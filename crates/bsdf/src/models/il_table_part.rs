@@ -4,25 +4,33 @@
 //! [`BodyTable::build`] makes (every entry uses the same shared microfacet set wherever it
 //! is computed).
 //!
-//! ## File format (`.fctpart`, version 1, little-endian)
+//! ## File format (`.fctpart`, version 2, little-endian)
+//!
+//! A framed file (`crate::storage::framed`: magic `FCTPART1`, u32 format version 2, u64
+//! payload length, payload, CRC-32); version 1 files (the same payload, unframed) are
+//! still read. The payload:
 //!
 //! | bytes | content |
 //! |---|---|
-//! | 8 | magic `FCTPART1` |
-//! | 4 | u32 format version (1) |
 //! | 4 | u32 length L of the header |
 //! | L | UTF-8 TOML header: `model = "il-body-part"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples`, `part`, `parts` |
 //! | 4 | u32 number of rows R |
 //! | R × (8 + E·24) | per row: u32 θ_i index, u32 entry count E, then E × (u32 θ_o index, u32 φ index, f64 value, f64 standard error) |
-//! | 4 | u32 CRC-32 (IEEE) of all preceding bytes |
 
-use super::il_table::{compute_rows, write_atomically, BodyTable, TableError, TableGrid, TableRow};
+use super::il_table::{compute_rows, BodyTable, TableError, TableGrid, TableRow};
 use crate::error::ParamResult;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"FCTPART1";
-const VERSION: u32 = 1;
+use crate::storage::atomic_file::write_atomically;
+use crate::storage::framed::Framed;
+
+const FRAME: Framed = Framed {
+    magic: b"FCTPART1",
+    version: 2,
+    legacy_version: Some(1),
+    what: "facette IL table part",
+};
 
 /// One part of a table.
 #[derive(Clone, Debug, PartialEq)]
@@ -76,8 +84,6 @@ impl TablePart {
     pub fn to_bytes(&self) -> Vec<u8> {
         let header = self.header();
         let mut out = Vec::new();
-        out.extend_from_slice(MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&(header.len() as u32).to_le_bytes());
         out.extend_from_slice(header.as_bytes());
         out.extend_from_slice(&(self.rows.len() as u32).to_le_bytes());
@@ -91,9 +97,7 @@ impl TablePart {
                 out.extend_from_slice(&se.to_le_bytes());
             }
         }
-        let crc = crc32fast::hash(&out);
-        out.extend_from_slice(&crc.to_le_bytes());
-        out
+        FRAME.frame(&out)
     }
 
     /// Parses a part; `path` names it in errors.
@@ -102,16 +106,11 @@ impl TablePart {
             path: path.to_string(),
             reason,
         };
-        if bytes.len() < 24 || &bytes[..8] != MAGIC {
-            return Err(bad("not a facette IL table part (bad magic number)".into()));
-        }
-        let (body, crc) = bytes.split_at(bytes.len() - 4);
-        if crc32fast::hash(body) != u32::from_le_bytes(crc.try_into().expect("4 bytes")) {
-            return Err(bad(
-                "checksum mismatch: the file is corrupt or truncated".into()
-            ));
-        }
-        let mut at = 8;
+        let body = FRAME
+            .unframe(bytes)
+            .map_err(|e| bad(e.to_string()))?
+            .payload;
+        let mut at = 0;
         let mut take = |n: usize| -> Result<&[u8], TableError> {
             let s = body
                 .get(at..at + n)
@@ -120,12 +119,6 @@ impl TablePart {
             Ok(s)
         };
         let u32_ = |s: &[u8]| u32::from_le_bytes(s.try_into().expect("4 bytes"));
-        let version = u32_(take(4)?);
-        if version != VERSION {
-            return Err(bad(format!(
-                "format version {version} is not supported (expected {VERSION})"
-            )));
-        }
         let hlen = u32_(take(4)?) as usize;
         let header =
             std::str::from_utf8(take(hlen)?).map_err(|_| bad("the header is not UTF-8".into()))?;

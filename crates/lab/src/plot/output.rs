@@ -2,7 +2,7 @@
 //! is written atomically, and the font is embedded (DejaVu Sans, registered once) so that
 //! PNG text renders the same on every machine without system fonts.
 
-use crate::atomic_file::write_atomically;
+use facette_bsdf::storage::atomic_file::write_atomically;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

@@ -21,8 +21,9 @@
 //! perspective is rejected.
 
 use super::bounds::Bounds3;
-use super::error::{GeometryError, GeometryResult};
+use super::error::GeometryResult;
 use super::interaction::{PrimHit, SurfaceHit};
+use super::planar::PlaneFrame;
 use super::ray::Ray;
 use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
 use super::transform::Transform;
@@ -32,54 +33,37 @@ use std::f64::consts::{PI, TAU};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Disk {
-    to_world: Transform,
-    normal: Vec3,
-    center: Vec3,
+    plane: PlaneFrame,
     area: f64,
 }
 
 impl Disk {
     pub fn new(to_world: &Transform, flip_normals: bool) -> GeometryResult<Disk> {
-        if !to_world.is_affine() {
-            return Err(GeometryError::UnsupportedTransform {
-                shape: "disk",
-                reason: "perspective transforms are not supported",
-            });
-        }
-        let to_world = if flip_normals {
-            *to_world * Transform::scale(Vec3::new(1.0, 1.0, -1.0))?
-        } else {
-            *to_world
-        };
-        let a = to_world.vector(Vec3::X);
-        let b = to_world.vector(Vec3::Y);
+        let plane = PlaneFrame::new(to_world, flip_normals, "disk")?;
+        let a = plane.to_world().vector(Vec3::X);
+        let b = plane.to_world().vector(Vec3::Y);
         Ok(Disk {
-            normal: to_world.normal(Vec3::Z).normalize(),
-            center: to_world.point(Vec3::ZERO),
             // The affine image of the unit disk is an ellipse of area π |a × b|.
             area: PI * a.cross(b).length(),
-            to_world,
+            plane,
         })
     }
 
     /// The object-to-world transform (with the `flip_normals` mirror, if any).
     #[inline]
     pub fn to_world(&self) -> &Transform {
-        &self.to_world
+        self.plane.to_world()
     }
 
     /// The unit normal.
     #[inline]
     pub fn normal(&self) -> Vec3 {
-        self.normal
+        self.plane.normal()
     }
 
     /// The box of the transformed square `[−1, 1]²` around the disk (conservative).
     pub fn bounds(&self) -> Bounds3 {
-        Bounds3::from_points(
-            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .map(|(x, y)| self.to_world.point(Vec3::new(x, y, 0.0))),
-        )
+        self.plane.square_bounds()
     }
 
     #[inline]
@@ -90,26 +74,12 @@ impl Disk {
     /// The hit in `(0, ray.t_max]`, found in object space; `local` is the object-space
     /// `(x, y)`.
     pub fn intersect_prim(&self, ray: &Ray) -> Option<PrimHit> {
-        let o = self.to_world.inverse_point(ray.origin);
-        let d = self.to_world.inverse_vector(ray.dir);
-        if d.z == 0.0 {
-            return None;
-        }
-        let t = -o.z / d.z;
-        if !(t > 0.0 && t <= ray.t_max) {
-            return None;
-        }
-        let x = o.x + t * d.x;
-        let y = o.y + t * d.y;
-        (x * x + y * y <= 1.0).then_some(PrimHit {
-            t,
-            local: Vec2::new(x, y),
-        })
+        let (t, local) = self.plane.intersect_plane(ray)?;
+        (local.x * local.x + local.y * local.y <= 1.0).then_some(PrimHit { t, local })
     }
 
     pub fn surface_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {
-        let p = ray.at(hit.t);
-        let p = p + self.normal * self.normal.dot(self.center - p);
+        let p = self.plane.reproject(ray.at(hit.t));
         let (x, y) = (hit.local.x, hit.local.y);
         let r = (x * x + y * y).sqrt();
         let mut v = y.atan2(x) / TAU;
@@ -117,16 +87,15 @@ impl Disk {
             v += 1.0;
         }
         let (cos_phi, sin_phi) = if r > 0.0 { (x / r, y / r) } else { (1.0, 0.0) };
+        let to_world = self.plane.to_world();
         SurfaceHit {
             t: hit.t,
             p,
-            ng: self.normal,
-            ns: self.normal,
+            ng: self.normal(),
+            ns: self.normal(),
             uv: Vec2::new(r, v),
-            dpdu: self.to_world.vector(Vec3::new(cos_phi, sin_phi, 0.0)),
-            dpdv: self
-                .to_world
-                .vector(TAU * r * Vec3::new(-sin_phi, cos_phi, 0.0)),
+            dpdu: to_world.vector(Vec3::new(cos_phi, sin_phi, 0.0)),
+            dpdv: to_world.vector(TAU * r * Vec3::new(-sin_phi, cos_phi, 0.0)),
             shape,
             prim: 0,
         }
@@ -142,8 +111,7 @@ impl Disk {
     /// both preserve uniformity): `(point, normal, 1/area)`.
     pub fn sample(&self, u: Vec2) -> (Vec3, Vec3, f64) {
         let d = square_to_disk_concentric(u);
-        let p = self.to_world.point(Vec3::new(d.x, d.y, 0.0));
-        (p, self.normal, 1.0 / self.area)
+        (self.plane.point(d.x, d.y), self.normal(), 1.0 / self.area)
     }
 
     /// A point seen from `p`: the area sample converted to solid angle, as pbrt-v4 and
@@ -155,7 +123,7 @@ impl Disk {
     /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
     /// produces the direction towards the point `q` of the disk.
     pub fn pdf_from(&self, p: Vec3, q: Vec3) -> f64 {
-        area_to_solid_angle(1.0 / self.area, p, q, self.normal)
+        area_to_solid_angle(1.0 / self.area, p, q, self.normal())
     }
 }
 

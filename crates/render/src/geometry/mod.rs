@@ -4,8 +4,10 @@
 //! - [`transform`]: [`Transform`] (matrix + inverse), Mitsuba's `look_at`.
 //! - Shapes with Mitsuba 3's parameterizations: [`Sphere`], [`Rectangle`], [`Disk`],
 //!   [`TriangleMesh`] (watertight ray–triangle test in [`triangle`]); [`Shape`] holds any
-//!   of them.
-//! - [`mesh_io`]: OBJ and PLY files into [`MeshData`]; [`generate`]: procedural meshes.
+//!   of them. The planar ones (rectangle, disk) share their frame and plane intersection
+//!   (`planar`).
+//! - [`mesh_io`]: OBJ and PLY files into [`MeshData`]; [`generate`]: procedural meshes;
+//!   [`vertex_normals`]: Mitsuba's vertex normals for meshes stored without.
 //! - [`interaction`]: [`SurfaceHit`] and its screen-space uv derivatives.
 //! - [`solid_angle_sampling`]: sampling a shape as seen from a point (area lights), with
 //!   each shape's best sampler: the sphere's cone, spherical rectangles and triangles.
@@ -32,6 +34,7 @@ pub mod generate;
 pub mod interaction;
 pub mod mesh_data;
 pub mod mesh_io;
+mod planar;
 pub mod ray;
 pub mod rectangle;
 pub mod scene_geometry;
@@ -43,6 +46,7 @@ pub mod spherical_triangle;
 pub mod transform;
 pub mod triangle;
 pub mod triangle_mesh;
+pub mod vertex_normals;
 
 pub use bounds::Bounds3;
 pub use bvh::Bvh;

@@ -18,8 +18,9 @@
 //! rejected.
 
 use super::bounds::Bounds3;
-use super::error::{GeometryError, GeometryResult};
+use super::error::GeometryResult;
 use super::interaction::{PrimHit, SurfaceHit};
+use super::planar::PlaneFrame;
 use super::ray::Ray;
 use super::solid_angle_sampling::{
     area_sample_from, area_to_solid_angle, use_spherical_sampling, ShapeSample,
@@ -30,57 +31,39 @@ use super::{Vec2, Vec3};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rectangle {
-    to_world: Transform,
+    plane: PlaneFrame,
     dpdu: Vec3,
     dpdv: Vec3,
-    normal: Vec3,
-    center: Vec3,
     area: f64,
 }
 
 impl Rectangle {
     pub fn new(to_world: &Transform, flip_normals: bool) -> GeometryResult<Rectangle> {
-        if !to_world.is_affine() {
-            return Err(GeometryError::UnsupportedTransform {
-                shape: "rectangle",
-                reason: "perspective transforms are not supported",
-            });
-        }
-        let to_world = if flip_normals {
-            *to_world * Transform::scale(Vec3::new(1.0, 1.0, -1.0))?
-        } else {
-            *to_world
-        };
-        let dpdu = to_world.vector(Vec3::new(2.0, 0.0, 0.0));
-        let dpdv = to_world.vector(Vec3::new(0.0, 2.0, 0.0));
-        let normal = to_world.normal(Vec3::Z).normalize();
+        let plane = PlaneFrame::new(to_world, flip_normals, "rectangle")?;
+        let dpdu = plane.to_world().vector(Vec3::new(2.0, 0.0, 0.0));
+        let dpdv = plane.to_world().vector(Vec3::new(0.0, 2.0, 0.0));
         Ok(Rectangle {
-            center: to_world.point(Vec3::ZERO),
             area: dpdu.cross(dpdv).length(),
-            to_world,
+            plane,
             dpdu,
             dpdv,
-            normal,
         })
     }
 
     /// The object-to-world transform (with the `flip_normals` mirror, if any).
     #[inline]
     pub fn to_world(&self) -> &Transform {
-        &self.to_world
+        self.plane.to_world()
     }
 
     /// The unit normal.
     #[inline]
     pub fn normal(&self) -> Vec3 {
-        self.normal
+        self.plane.normal()
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        Bounds3::from_points(
-            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .map(|(x, y)| self.to_world.point(Vec3::new(x, y, 0.0))),
-        )
+        self.plane.square_bounds()
     }
 
     #[inline]
@@ -91,32 +74,16 @@ impl Rectangle {
     /// The hit in `(0, ray.t_max]`, found in object space (where the plane is z = 0);
     /// `local` is the object-space `(x, y)`.
     pub fn intersect_prim(&self, ray: &Ray) -> Option<PrimHit> {
-        let o = self.to_world.inverse_point(ray.origin);
-        let d = self.to_world.inverse_vector(ray.dir);
-        if d.z == 0.0 {
-            return None;
-        }
-        let t = -o.z / d.z;
-        if !(t > 0.0 && t <= ray.t_max) {
-            return None;
-        }
-        let x = o.x + t * d.x;
-        let y = o.y + t * d.y;
-        (x.abs() <= 1.0 && y.abs() <= 1.0).then_some(PrimHit {
-            t,
-            local: Vec2::new(x, y),
-        })
+        let (t, local) = self.plane.intersect_plane(ray)?;
+        (local.x.abs() <= 1.0 && local.y.abs() <= 1.0).then_some(PrimHit { t, local })
     }
 
     pub fn surface_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {
-        let p = ray.at(hit.t);
-        // Re-project onto the plane, as Mitsuba does.
-        let p = p + self.normal * self.normal.dot(self.center - p);
         SurfaceHit {
             t: hit.t,
-            p,
-            ng: self.normal,
-            ns: self.normal,
+            p: self.plane.reproject(ray.at(hit.t)),
+            ng: self.normal(),
+            ns: self.normal(),
             uv: hit.local * 0.5 + Vec2::splat(0.5),
             dpdu: self.dpdu,
             dpdv: self.dpdv,
@@ -134,17 +101,15 @@ impl Rectangle {
     /// Uniform sample: the affine image of a uniform point of the square, so the density
     /// is the constant `1/area`.
     pub fn sample(&self, u: Vec2) -> (Vec3, Vec3, f64) {
-        let p = self
-            .to_world
-            .point(Vec3::new(2.0 * u.x - 1.0, 2.0 * u.y - 1.0, 0.0));
-        (p, self.normal, 1.0 / self.area)
+        let p = self.plane.point(2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
+        (p, self.normal(), 1.0 / self.area)
     }
 
     /// The spherical rectangle seen from `p`, where spherical sampling applies: the shape
     /// is a true rectangle (a shear makes a parallelogram, which the construction does not
     /// cover) and its solid angle is in the usable range.
     fn spherical_from(&self, p: Vec3) -> Option<SphericalRectangle> {
-        let corner = self.to_world.point(Vec3::new(-1.0, -1.0, 0.0));
+        let corner = self.plane.point(-1.0, -1.0);
         let sr = SphericalRectangle::new(p, corner, self.dpdu, self.dpdv)?;
         use_spherical_sampling(sr.solid_angle()).then_some(sr)
     }
@@ -156,7 +121,7 @@ impl Rectangle {
         match self.spherical_from(p) {
             Some(sr) => sr.sample(u).map(|s| ShapeSample {
                 point: s.point,
-                normal: self.normal,
+                normal: self.normal(),
                 pdf: s.pdf,
             }),
             None => area_sample_from(p, self.sample(u)),
@@ -168,7 +133,7 @@ impl Rectangle {
     pub fn pdf_from(&self, p: Vec3, q: Vec3) -> f64 {
         match self.spherical_from(p) {
             Some(sr) => 1.0 / sr.solid_angle(),
-            None => area_to_solid_angle(1.0 / self.area, p, q, self.normal),
+            None => area_to_solid_angle(1.0 / self.area, p, q, self.normal()),
         }
     }
 }

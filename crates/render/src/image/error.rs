@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use facette_bsdf::storage::atomic_file::AtomicWriteError;
 use facette_bsdf::ParamError;
 use thiserror::Error;
 
@@ -70,6 +71,15 @@ impl ImageError {
             | ImageError::Write { path, .. }
             | ImageError::InvalidData { path, .. }
             | ImageError::Param { path, .. } => path,
+        }
+    }
+}
+
+impl From<AtomicWriteError> for ImageError {
+    fn from(e: AtomicWriteError) -> ImageError {
+        ImageError::Write {
+            path: e.path,
+            reason: e.reason,
         }
     }
 }

@@ -11,7 +11,7 @@
 //! carry them) are replaced by 0 so no NaN ever reaches a texture or a light.
 //!
 //! Files are written with ZIP (16-line) compression in scan lines, the most widely readable
-//! lossless layout, and atomically (see `atomic_write`).
+//! lossless layout, and atomically (`facette_bsdf::storage::atomic_file`).
 
 use std::collections::HashMap;
 use std::io::{BufWriter, ErrorKind};
@@ -22,9 +22,9 @@ use exr::prelude::{
     Layers, ReadChannels, ReadLayers, SmallVec, Text, WritableImage,
 };
 
-use super::atomic_write::{write_atomically, Existing};
 use super::error::ImageError;
 use super::rgb_image::RgbImage;
+use facette_bsdf::storage::atomic_file::{write_atomically_with, Existing};
 
 const FORMAT: &str = "OpenEXR";
 
@@ -546,12 +546,13 @@ fn write_channels(
         AnyChannels::sort(list),
     );
     let image = Image::from_layer(layer);
-    write_atomically(path, existing, |w: &mut BufWriter<&std::fs::File>| {
+    write_atomically_with(path, existing, |w: &mut BufWriter<&std::fs::File>| {
         image
             .write()
             .to_buffered(w)
             .map_err(|e| format!("OpenEXR encoding failed: {e}"))
     })
+    .map_err(ImageError::from)
 }
 
 /// Writes an RGB image as 32-bit float `R`, `G`, `B` channels, each value multiplied by

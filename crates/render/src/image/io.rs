@@ -8,7 +8,7 @@
 //! files are either sRGB-encoded colour or raw data, as the caller says through
 //! [`ColorEncoding`]. EXR and HDR files hold linear values by definition.
 //!
-//! Every write is atomic (temporary file, fsync, rename; see `atomic_write`).
+//! Every write is atomic (temporary file, fsync, rename; see `facette_bsdf::storage::atomic_file`).
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, ErrorKind, Read};
@@ -16,11 +16,11 @@ use std::path::Path;
 
 use image::{DynamicImage, ImageFormat, ImageReader};
 
-use super::atomic_write::{write_atomically, Existing};
 use super::error::ImageError;
 use super::exr_file::{read_exr_rgb, write_exr_rgb};
 use super::rgb_image::RgbImage;
 use super::srgb::{linear_to_srgb8, srgb8_to_linear_table, srgb_to_linear};
+use facette_bsdf::storage::atomic_file::{write_atomically_with, Existing};
 
 /// How the integer samples of an 8/16-bit file relate to linear values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -299,10 +299,11 @@ fn write_png(path: &Path, image: &RgbImage, scale: f64) -> Result<(), ImageError
         .iter()
         .flat_map(|p| p.map(|v| linear_to_srgb8(v as f64 * scale)))
         .collect();
-    write_atomically(path, Existing::Replace, |out: &mut BufWriter<&File>| {
+    write_atomically_with(path, Existing::Replace, |out: &mut BufWriter<&File>| {
         image::codecs::png::PngEncoder::new(out)
             .write_image(&bytes, w, h, image::ExtendedColorType::Rgb8)
             .map_err(|e| format!("PNG encoding failed: {e}"))
     })
     .map(|_| ())
+    .map_err(ImageError::from)
 }

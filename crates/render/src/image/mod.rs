@@ -18,7 +18,6 @@
 // rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod atomic_write;
 pub mod constant_environment;
 pub mod distribution_2d;
 pub mod environment;

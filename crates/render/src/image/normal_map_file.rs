@@ -6,13 +6,13 @@
 //! Validation of the pixels (grey images, non-unit or downward normals) is done by
 //! [`facette_bsdf::models::glint::NormalMap::from_pixels`], which names the first bad pixel.
 
-use super::atomic_write::{write_atomically, Existing};
 use super::error::ImageError;
 use super::exr_file::write_exr_rgb;
 use super::io::{read_image, ColorEncoding};
 use super::rgb_image::RgbImage;
 use facette_bsdf::models::glint::{NormalEncoding, NormalMap};
 use facette_bsdf::spec::{DecodedImage, NormalMapReader};
+use facette_bsdf::storage::atomic_file::{write_atomically_with, Existing};
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
@@ -92,12 +92,13 @@ fn write_png16(path: &Path, map: &NormalMap) -> Result<(), ImageError> {
                 .flat_map(u16::to_ne_bytes)
         })
         .collect();
-    write_atomically(path, Existing::Replace, |out: &mut BufWriter<&File>| {
+    write_atomically_with(path, Existing::Replace, |out: &mut BufWriter<&File>| {
         image::codecs::png::PngEncoder::new(out)
             .write_image(&bytes, w, h, image::ExtendedColorType::Rgb16)
             .map_err(|e| format!("PNG encoding failed: {e}"))
     })
     .map(|_| ())
+    .map_err(ImageError::from)
 }
 
 #[cfg(test)]

@@ -32,11 +32,11 @@ use facette_bsdf::{ParamError, ParamResult, Spectrum};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::atomic_write::Existing;
 use super::environment::{direction_to_uv, uv_to_direction};
 use super::error::ImageError;
 use super::exr_file::{write_exr_rgb, MAX_PIXELS};
 use super::rgb_image::{from_spectrum, RgbImage};
+use facette_bsdf::storage::atomic_file::Existing;
 
 /// Parameters of the procedural sky (see the module table).
 #[derive(Clone, Debug, PartialEq)]

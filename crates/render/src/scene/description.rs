@@ -1,4 +1,4 @@
-//! The scene file as written (TOML), deserialized with serde; `load.rs` validates it and
+//! The scene file as written (TOML), deserialized with serde; `load/` validates it and
 //! builds the [`Scene`](super::Scene). `docs/scene-format.md` documents every key.
 //!
 //! Mitsuba XML scenes are translated into this same description (`super::mitsuba`); the

@@ -1,12 +1,18 @@
-//! Scenes: the TOML description (`description`), its loading with file:line errors
-//! (`load`), Mitsuba 3 XML scenes translated into the same description (`mitsuba`), and
-//! the built [`Scene`] the integrator renders.
+//! Scenes: the TOML description (`description`), its building into a [`Scene`] with
+//! file:line errors (`load`), Mitsuba 3 XML scenes translated into the same description
+//! (`mitsuba`), and the built [`Scene`] the integrator renders.
+//!
+//! Imports run one way: `mitsuba` → `load` → `source`, `error`, `description`; `load`
+//! never imports `mitsuba`.
 
 pub mod description;
+mod error;
 pub mod load;
 pub mod mitsuba;
+mod source;
 
-pub use load::{load_scene_str, SceneError};
+pub use error::SceneError;
+pub use load::load_scene_str;
 
 use std::path::Path;
 

@@ -13,8 +13,13 @@
 //! - [`sensor`], [`integrator`], [`bsdf`], [`texture`], [`shape`], [`emitter`]: one plugin
 //!   kind each, mapped onto the description's camera, film, integrator, materials, objects
 //!   and lights;
-//! - [`translator`]: the state they share (ids, locations, materials, warnings);
-//! - [`vertex_normals`]: Mitsuba's vertex normals for meshes stored without.
+//! - [`translator`]: the state they share (ids, locations, materials, warnings).
+//!
+//! Meshes stored without normals are marked for Mitsuba's vertex normals
+//! (`MeshNormals::ComputedIfMissing`), which the builder computes.
+//!
+//! The result is built by the scene builder's public entry, [`build_scene`]; this module
+//! imports nothing else of `super::load`.
 //!
 //! Errors name the file and line of the element at fault; parameters that only change the
 //! noise (a sampler type, say) are warnings, printed once, in [`Scene::warnings`].
@@ -31,11 +36,11 @@ mod texture;
 mod transform;
 mod translator;
 mod values;
-pub(crate) mod vertex_normals;
 mod xml;
 
 use super::description::SceneDesc;
-use super::load::{build, fnv1a, Ctx, Spans};
+use super::load::build_scene;
+use super::source::{fnv1a, Spans};
 use super::{Scene, SceneError};
 use plugin::{Plugin, Registry, Value};
 use std::path::Path;
@@ -133,14 +138,11 @@ pub fn load_mitsuba_scene(path: &Path, defines: &[(String, String)]) -> Result<S
     for (k, v) in defines {
         hashed.push_str(&format!("\u{0}-D{k}={v}"));
     }
-    let ctx = Ctx {
-        spans: Spans::Table {
-            file: path,
-            locations: &cx.locations,
-        },
-        base_dir: main_dir,
+    let spans = Spans::Table {
+        file: path,
+        locations: &cx.locations,
     };
-    let mut built = build(&ctx, desc, fnv1a(hashed.as_bytes()))?;
+    let mut built = build_scene(spans, main_dir, desc, fnv1a(hashed.as_bytes()))?;
     let mut warnings = std::mem::take(&mut cx.warnings);
     clip.check(&built, &mut warnings);
     built.warnings = warnings;

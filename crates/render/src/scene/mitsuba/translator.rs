@@ -4,7 +4,7 @@
 use super::plugin::{Plugin, Registry};
 use super::preprocess::resolve;
 use super::xml::Pos;
-use crate::scene::load::Location;
+use crate::scene::source::Location;
 use crate::scene::SceneError;
 use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;

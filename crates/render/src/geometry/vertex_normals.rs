@@ -4,13 +4,13 @@
 //! normals from polygonal facets", JGT 3(1), 1998), computed on the world-space
 //! positions, as Mitsuba does after applying `to_world`.
 
-use crate::geometry::{MeshData, Transform, Vec3};
+use super::{MeshData, Transform, Vec3};
 
 /// Gives `data` angle-weighted vertex normals computed in world space (placed by
 /// `to_world`) and returned to object space, so that the mesh's own normal transform
 /// takes them back exactly. A vertex whose triangles are all degenerate keeps the normal
 /// of no triangle: it gets +z (such a vertex is never hit by a ray).
-pub(crate) fn add_vertex_normals(data: &mut MeshData, to_world: &Transform) {
+pub fn add_vertex_normals(data: &mut MeshData, to_world: &Transform) {
     let world: Vec<Vec3> = data.positions.iter().map(|p| to_world.point(*p)).collect();
     let mut sums = vec![Vec3::ZERO; world.len()];
     for t in data.indices.chunks_exact(3) {

@@ -1,0 +1,96 @@
+//! What the planar shapes (rectangle, disk) share: an object space where the shape lies in
+//! the plane `z = 0` with normal +z, Mitsuba's `flip_normals` as a mirror of that space,
+//! the ray–plane intersection done in object space, and the re-projection of world hits
+//! onto the plane. Each shape adds only its outline, parameterization and sampling.
+
+use super::bounds::Bounds3;
+use super::error::{GeometryError, GeometryResult};
+use super::ray::Ray;
+use super::transform::Transform;
+use super::{Vec2, Vec3};
+
+/// The placement of a planar shape: its object-to-world transform and what follows from
+/// it (world normal and centre).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct PlaneFrame {
+    to_world: Transform,
+    normal: Vec3,
+    center: Vec3,
+}
+
+impl PlaneFrame {
+    /// The frame of the shape named `shape` (for errors). Only affine transforms keep a
+    /// plane a plane with a constant normal, so perspective is rejected; `flip_normals`
+    /// composes `to_world · scale(1, 1, −1)` as Mitsuba does, which inverts the normal and
+    /// keeps `uv` and the tangents.
+    pub fn new(
+        to_world: &Transform,
+        flip_normals: bool,
+        shape: &'static str,
+    ) -> GeometryResult<PlaneFrame> {
+        if !to_world.is_affine() {
+            return Err(GeometryError::UnsupportedTransform {
+                shape,
+                reason: "perspective transforms are not supported",
+            });
+        }
+        let to_world = if flip_normals {
+            *to_world * Transform::scale(Vec3::new(1.0, 1.0, -1.0))?
+        } else {
+            *to_world
+        };
+        Ok(PlaneFrame {
+            normal: to_world.normal(Vec3::Z).normalize(),
+            center: to_world.point(Vec3::ZERO),
+            to_world,
+        })
+    }
+
+    /// The object-to-world transform (with the `flip_normals` mirror, if any).
+    #[inline]
+    pub fn to_world(&self) -> &Transform {
+        &self.to_world
+    }
+
+    /// The unit world normal.
+    #[inline]
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    /// The world point at object-space `(x, y, 0)`.
+    #[inline]
+    pub fn point(&self, x: f64, y: f64) -> Vec3 {
+        self.to_world.point(Vec3::new(x, y, 0.0))
+    }
+
+    /// The box of the transformed square `[−1, 1]²` (which holds both shapes' outlines).
+    pub fn square_bounds(&self) -> Bounds3 {
+        Bounds3::from_points(
+            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, y)| self.point(x, y)),
+        )
+    }
+
+    /// The ray's crossing of the plane in `(0, ray.t_max]`, found in object space (where
+    /// the plane is z = 0, so the test is exact for rays nearly parallel to it): `t` and
+    /// the object-space `(x, y)`. Rays parallel to the plane miss.
+    pub fn intersect_plane(&self, ray: &Ray) -> Option<(f64, Vec2)> {
+        let o = self.to_world.inverse_point(ray.origin);
+        let d = self.to_world.inverse_vector(ray.dir);
+        if d.z == 0.0 {
+            return None;
+        }
+        let t = -o.z / d.z;
+        if !(t > 0.0 && t <= ray.t_max) {
+            return None;
+        }
+        Some((t, Vec2::new(o.x + t * d.x, o.y + t * d.y)))
+    }
+
+    /// `p` moved onto the plane along the normal, as Mitsuba does with its hits: spawned
+    /// rays then start from the surface itself.
+    #[inline]
+    pub fn reproject(&self, p: Vec3) -> Vec3 {
+        p + self.normal * self.normal.dot(self.center - p)
+    }
+}

@@ -1,0 +1,88 @@
+//! The film and integrator settings of a scene: sizes, samples, filter, sampler, depths.
+
+use super::context::Ctx;
+use crate::film::Filter;
+use crate::sampler::SamplerKind;
+use crate::scene::description::{FilmDesc, IntegratorDesc};
+use crate::scene::{FilmSettings, IntegratorSettings, SceneError};
+use toml::Spanned;
+
+/// The film of the description (defaults where there is no `[film]`), validated.
+pub(super) fn create_film(
+    ctx: &Ctx,
+    desc: Option<Spanned<FilmDesc>>,
+) -> Result<FilmSettings, SceneError> {
+    let film_span = desc.as_ref().map(|f| f.span());
+    let f = desc.map(|f| f.into_inner()).unwrap_or_default();
+    if f.width == 0 || f.height == 0 || f.width > 65536 || f.height > 65536 {
+        return Err(ctx.err(
+            film_span.clone(),
+            format!("film size {}×{} is outside 1…65536", f.width, f.height),
+        ));
+    }
+    if f.spp == 0 {
+        return Err(ctx.err(film_span.clone(), "`spp` must be at least 1"));
+    }
+    if !f.exposure.is_finite() {
+        return Err(ctx.err(film_span.clone(), "`exposure` must be finite"));
+    }
+    let filter = match f.filter.as_str() {
+        "box" => Filter::Box,
+        "gaussian" => {
+            if !(f.filter_stddev > 0.0
+                && f.filter_stddev.is_finite()
+                && f.filter_radius > 0.0
+                && f.filter_radius.is_finite())
+            {
+                return Err(ctx.err(
+                    film_span.clone(),
+                    "`filter_stddev` and `filter_radius` must be positive",
+                ));
+            }
+            Filter::gaussian(f.filter_stddev, f.filter_radius)
+        }
+        other => {
+            return Err(ctx.err(
+                film_span,
+                format!(
+                    "unknown filter `{other}`; valid: {}",
+                    Filter::NAMES.join(", ")
+                ),
+            ));
+        }
+    };
+    let Some(sampler) = SamplerKind::parse(&f.sampler) else {
+        return Err(ctx.err(
+            film_span,
+            format!(
+                "unknown sampler `{}`; valid: {}",
+                f.sampler,
+                SamplerKind::NAMES.join(", ")
+            ),
+        ));
+    };
+    Ok(FilmSettings {
+        width: f.width,
+        height: f.height,
+        spp: f.spp,
+        filter,
+        exposure: f.exposure,
+        sampler,
+    })
+}
+
+/// The integrator of the description (defaults where there is no `[integrator]`).
+pub(super) fn create_integrator(
+    ctx: &Ctx,
+    desc: Option<Spanned<IntegratorDesc>>,
+) -> Result<IntegratorSettings, SceneError> {
+    let integ_span = desc.as_ref().map(|i| i.span());
+    let i = desc.map(|i| i.into_inner()).unwrap_or_default();
+    if i.max_depth == 0 || i.max_depth > 1024 {
+        return Err(ctx.err(integ_span, "`max_depth` must be in 1…1024"));
+    }
+    Ok(IntegratorSettings {
+        max_depth: i.max_depth,
+        rr_depth: i.rr_depth,
+    })
+}
