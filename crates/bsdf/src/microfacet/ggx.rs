@@ -126,6 +126,14 @@ impl Distribution for Ggx {
 
     /// Heitz 2018, "Sampling the GGX Distribution of Visible Normals" (JCGT 7(4)):
     /// stretch the view, sample the projected hemisphere, unstretch.
+    ///
+    /// [Dupuy & Benyoub 2023]'s spherical caps sample the same density with fewer operations
+    /// (0.70× the time in the kernel bench). They are not used here because they map u to m
+    /// differently, and the albedo tables integrate over u piecewise
+    /// (models/albedo_tables.rs), which is built for this map. Measured with the caps: 16- and
+    /// 48-point albedos differed by 9.9e-3 (the limit is 1.5e-3), and the compensated
+    /// conductor failed its estimator χ² test. The caps are used below the horizon
+    /// (models/smith_microsurface.rs).
     #[inline]
     fn sample_visible(&self, v: Vec3, u: Vec2) -> Vec3 {
         let vh = Vec3::new(self.ax * v.x, self.ay * v.y, v.z.max(0.0)).normalize();
