@@ -5,7 +5,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::{BsdfContext, Vec3};
 
 const MODELS: &[(&str, &str)] = &[

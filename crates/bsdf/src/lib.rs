@@ -13,8 +13,8 @@
 //! - [`bsdf`]: the BSDF interface (`eval`, `sample`, `pdf`, flags, transport mode,
 //!   stochastic evaluation).
 //! - [`models`]: one file per model.
-//! - [`spec`]: materials written as TOML tables (`{type = "dielectric", …}`), validated and
-//!   built into BSDFs.
+//! - [`recipe`]: materials written as TOML tables (`{type = "dielectric", …}`), parsed and
+//!   validated into recipes (`MaterialRecipe`), which build BSDFs.
 //! - [`validation`]: chi-square goodness of fit, normalization, reciprocity, energy and
 //!   NaN sweeps — the checks behind `facette validate` and the test suite.
 //!
@@ -31,7 +31,7 @@ pub mod fresnel;
 pub mod math;
 pub mod microfacet;
 pub mod models;
-pub mod spec;
+pub mod recipe;
 
 pub mod validation;
 

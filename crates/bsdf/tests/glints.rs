@@ -14,7 +14,7 @@ use facette_bsdf::models::glint::reference::{
 use facette_bsdf::models::glint::{
     generate, GlintBsdf, GlintParams, GlintSurface, NormalMap, NormalMapKind,
 };
-use facette_bsdf::spec::{build_material, parse_inline_table, MaterialRecipe};
+use facette_bsdf::recipe::{build_material, parse_inline_table, MaterialRecipe};
 use facette_bsdf::{Bsdf, BsdfContext, Spectrum, Vec2, Vec3};
 use std::sync::Arc;
 

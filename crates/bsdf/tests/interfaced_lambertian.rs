@@ -8,7 +8,7 @@ use facette_bsdf::microfacet::{Gaussian, Masking, Ndf};
 use facette_bsdf::models::il_table::BodyTable;
 use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::validation::measurements::hemispherical_reflectance;
 use facette_bsdf::{Bsdf, BsdfContext, Spectrum, Vec3};
 use std::sync::Arc;

@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Context, Result};
 use facette_bsdf::models::glint::GlintBsdf;
-use facette_bsdf::spec::{build_material_with_reader, parse_inline_table, MaterialRecipe};
+use facette_bsdf::recipe::{build_material_with_reader, parse_inline_table, MaterialRecipe};
 use facette_bsdf::{Bsdf, Vec2};
 use facette_render::image::ImageNormalMapReader;
 use std::sync::Arc;

@@ -5,7 +5,7 @@
 //! under a point light), and the example scenes render without NaN.
 
 use facette_bsdf::math::rng::Pcg32;
-use facette_bsdf::spec::build_material_in;
+use facette_bsdf::recipe::build_material_in;
 use facette_bsdf::{BsdfContext, Spectrum};
 use facette_render::geometry::{Shape, Vec2, Vec3};
 use facette_render::image::{write_image, RgbImage};

@@ -49,7 +49,7 @@ use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
-use crate::spec::params::check_spectrum;
+use crate::recipe::params::check_spectrum;
 use std::sync::Arc;
 
 /// How the body term is evaluated.

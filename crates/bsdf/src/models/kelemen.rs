@@ -40,7 +40,7 @@ use crate::math::spectrum::Spectrum;
 use crate::math::warp::hammersley;
 use crate::math::{reflect, Vec3, PI, TWO_PI};
 use crate::microfacet::half_vector_density::HalfVectorDensity;
-use crate::spec::params::check_spectrum;
+use crate::recipe::params::check_spectrum;
 
 /// Number of intervals of the albedo table over [0, π/2].
 const TABLE_INTERVALS: usize = 90;

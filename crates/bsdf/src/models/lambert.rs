@@ -11,7 +11,7 @@ use crate::error::ParamResult;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{Vec3, INV_PI};
-use crate::spec::params::check_spectrum;
+use crate::recipe::params::check_spectrum;
 
 #[derive(Clone, Debug)]
 pub struct Lambert {

@@ -27,7 +27,7 @@ use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
 use crate::microfacet::{Gaussian, Masking, Ndf};
-use crate::spec::params::check_spectrum;
+use crate::recipe::params::check_spectrum;
 
 /// How a model estimates its microfacet integral.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -178,7 +178,7 @@ pub fn parse_specular_lobe(p: &Params, allow_smooth: bool) -> ParamResult<Option
 mod tests {
     use super::*;
     use crate::microfacet::Distribution;
-    use crate::spec::parse_inline_table;
+    use crate::recipe::parse_inline_table;
 
     fn lobe(s: &str) -> ParamResult<Option<SpecularLobe>> {
         let t = parse_inline_table(s).unwrap();

@@ -227,11 +227,11 @@ impl MaterialRecipe {
                 Lambert::new(r)?;
                 Ok(MaterialRecipe::Lambert { reflectance: r })
             }
-            "oren-nayar" => build_oren_nayar(&p),
-            "conductor" => build_conductor(&p),
-            "dielectric" => build_dielectric(&p),
-            "kelemen" => build_kelemen(&p),
-            "il" | "interfaced-lambertian" => build_il(&p, base_dir),
+            "oren-nayar" => parse_oren_nayar(&p),
+            "conductor" => parse_conductor(&p),
+            "dielectric" => parse_dielectric(&p),
+            "kelemen" => parse_kelemen(&p),
+            "il" | "interfaced-lambertian" => parse_il(&p, base_dir),
             "glint" => {
                 let g = parse_glint(&p, base_dir, reader)?;
                 p.finish(&keys(GLINT_KEYS, false))?;
@@ -534,7 +534,7 @@ pub fn parse_evaluation(p: &Params, default_samples: usize) -> ParamResult<Integ
     }
 }
 
-fn build_oren_nayar(p: &Params) -> ParamResult<MaterialRecipe> {
+fn parse_oren_nayar(p: &Params) -> ParamResult<MaterialRecipe> {
     let r = p.spectrum("reflectance")?.unwrap_or(Spectrum::splat(0.5));
     let sigma = p.required_f64("sigma")?;
     let (model, evaluation) = match p.str("model")?.unwrap_or("exact") {
@@ -653,7 +653,7 @@ fn parse_masking_for(
     }
 }
 
-fn build_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
+fn parse_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
     let ndf = parse_distribution(p, true)?;
     let energy = parse_energy(p)?;
     let masking = parse_masking_for(p, ndf.as_ref(), energy)?;
@@ -686,7 +686,7 @@ fn build_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
     Ok(recipe)
 }
 
-fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
+fn parse_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
     let preset = p.str("preset")?;
     let (ndf, ior) = match preset {
         Some(name) => {
@@ -772,7 +772,7 @@ fn build_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
     Ok(recipe)
 }
 
-fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<MaterialRecipe> {
+fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<MaterialRecipe> {
     let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
     let ni = p.f64_or("ni", 1.5)?;
     let scattering = Scattering::parse(p.str("scattering")?.unwrap_or("single"))?;
@@ -835,7 +835,7 @@ fn build_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<MaterialRecip
     Ok(recipe)
 }
 
-fn build_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
+fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let name = p.str("distribution")?.unwrap_or("ward");
     let rough = match name {
         "phong" => p.required_f64("exponent")?,
@@ -857,7 +857,7 @@ fn build_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spec::parse_inline_table;
+    use crate::recipe::parse_inline_table;
 
     fn build(s: &str) -> ParamResult<Arc<dyn Bsdf>> {
         build_material(&parse_inline_table(s).unwrap())
