@@ -10,6 +10,7 @@
 //!   Phong, with Smith Λ/G1, samplers of D(m)|m·n| and of visible normals; masking choices;
 //!   KSK01's half-vector densities; the shared specular microfacet lobe.
 //! - [`fresnel`]: exact dielectric and conductor Fresnel, Schlick, r_e and r_i.
+//! - [`checks`]: the valid range of every shared parameter, defined once.
 //! - [`bsdf`]: the BSDF interface (`eval`, `sample`, `pdf`, flags, transport mode,
 //!   stochastic evaluation).
 //! - [`models`]: one file per model.
@@ -26,6 +27,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bsdf;
+pub mod checks;
 pub mod error;
 pub mod fresnel;
 pub mod math;

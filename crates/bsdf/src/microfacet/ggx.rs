@@ -10,7 +10,8 @@
 //! θ_m uses the second, independent number.
 
 use super::{normal_from_slopes, visible_density, Distribution};
-use crate::error::{check_range, Bounds, ParamResult};
+use crate::checks::check_alpha;
+use crate::error::ParamResult;
 use crate::math::{fmt_num, Vec2, Vec3, PI, TWO_PI};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,9 +28,15 @@ pub struct Ggx {
 
 impl Ggx {
     pub fn new(alpha_x: f64, alpha_y: f64) -> ParamResult<Self> {
-        check_range("alpha_u", alpha_x, 0.0, 10.0, Bounds::OpenClosed)?;
-        check_range("alpha_v", alpha_y, 0.0, 10.0, Bounds::OpenClosed)?;
+        check_alpha("alpha_u", alpha_x)?;
+        check_alpha("alpha_v", alpha_y)?;
         Ok(Self::from_alphas(alpha_x, alpha_y))
+    }
+
+    /// Anisotropic GGX from widths the caller has already checked (a material recipe
+    /// checks them once, with the smooth limit).
+    pub(crate) fn from_checked(alpha_x: f64, alpha_y: f64) -> Self {
+        Self::from_alphas(alpha_x, alpha_y)
     }
 
     fn from_alphas(ax: f64, ay: f64) -> Self {
@@ -45,8 +52,8 @@ impl Ggx {
     }
 
     pub fn isotropic(alpha: f64) -> ParamResult<Self> {
-        check_range("alpha", alpha, 0.0, 10.0, Bounds::OpenClosed)?;
-        Self::new(alpha, alpha)
+        check_alpha("alpha", alpha)?;
+        Ok(Self::from_alphas(alpha, alpha))
     }
 
     /// Isotropic GGX without validation, for internal proposals (width must be > 0).

@@ -39,7 +39,8 @@ use super::oren_nayar::QUADRATURE_SEED;
 use super::vcavity::{self, IlFacet, Orders};
 use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
+use crate::error::{ParamError, ParamResult};
 use crate::fresnel::{
     external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance,
 };
@@ -49,7 +50,6 @@ use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
-use crate::recipe::params::check_spectrum;
 use std::sync::Arc;
 
 /// How the body term is evaluated.
@@ -139,19 +139,13 @@ impl InterfacedLambertian {
         evaluation: BodyEvaluation,
         scattering: Scattering,
     ) -> ParamResult<Self> {
-        check_spectrum("kd", kd, 0.0, 1.0)?;
+        check_reflectance("kd", kd)?;
         check_range("ni", ni, 1.0, 10.0, Bounds::Closed)?;
         let re = external_diffuse_reflectance(ni);
         let ri = internal_diffuse_reflectance(ni);
         let body_factor = kd.map(|k| k / (ni * ni * (1.0 - k * ri)));
         if let BodyEvaluation::Quadrature { samples } = evaluation {
-            if samples < 8 {
-                return Err(ParamError::OutOfRange {
-                    name: "samples".into(),
-                    value: samples as f64,
-                    expected: "samples >= 8".into(),
-                });
-            }
+            check_min_count("samples", samples, 8)?;
         }
         let integral = match &lobe {
             Some(l) => Some(MicrofacetIntegral::new(l.ndf.clone(), l.masking)?),

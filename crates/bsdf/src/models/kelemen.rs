@@ -32,7 +32,8 @@
 
 use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{check_min_count, check_reflectance};
+use crate::error::ParamResult;
 use crate::fresnel::Fresnel;
 use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::{Pcg32, RandomSource};
@@ -40,7 +41,6 @@ use crate::math::spectrum::Spectrum;
 use crate::math::warp::hammersley;
 use crate::math::{reflect, Vec3, PI, TWO_PI};
 use crate::microfacet::half_vector_density::HalfVectorDensity;
-use crate::recipe::params::check_spectrum;
 
 /// Number of intervals of the albedo table over [0, π/2].
 const TABLE_INTERVALS: usize = 90;
@@ -75,14 +75,8 @@ impl Kelemen {
         kd: Spectrum,
         table_samples: usize,
     ) -> ParamResult<Self> {
-        check_spectrum("kd", kd, 0.0, 1.0)?;
-        if table_samples < 64 {
-            return Err(ParamError::OutOfRange {
-                name: "table_samples".into(),
-                value: table_samples as f64,
-                expected: "table_samples >= 64".into(),
-            });
-        }
+        check_reflectance("kd", kd)?;
+        check_min_count("table_samples", table_samples, 64)?;
         let mut k = Kelemen {
             density,
             fresnel,
@@ -95,7 +89,7 @@ impl Kelemen {
 
     /// The same material with another matte colour k (the tables are shared).
     pub fn with_kd(&self, kd: Spectrum) -> ParamResult<Self> {
-        check_spectrum("kd", kd, 0.0, 1.0)?;
+        check_reflectance("kd", kd)?;
         Ok(Kelemen { kd, ..self.clone() })
     }
 
@@ -399,9 +393,4 @@ fn albedo_in(table: &[Spectrum], theta: f64) -> Spectrum {
     let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
     let t = x - k as f64;
     table[k] * (1.0 - t) + table[k + 1] * t
-}
-
-/// Validates a Kelemen Fresnel index.
-pub fn check_ior(ior: f64) -> ParamResult<f64> {
-    check_range("ior", ior, 1.0, 100.0, Bounds::OpenClosed)
 }

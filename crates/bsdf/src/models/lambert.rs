@@ -7,11 +7,11 @@
 use super::cosine_lobe::{cosine_same_side_pdf, sample_cosine_same_side};
 use super::to_upper_pair;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::checks::check_reflectance;
 use crate::error::ParamResult;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{Vec3, INV_PI};
-use crate::recipe::params::check_spectrum;
 
 #[derive(Clone, Debug)]
 pub struct Lambert {
@@ -21,7 +21,7 @@ pub struct Lambert {
 impl Lambert {
     pub fn new(reflectance: Spectrum) -> ParamResult<Self> {
         Ok(Lambert {
-            reflectance: check_spectrum("reflectance", reflectance, 0.0, 1.0)?,
+            reflectance: check_reflectance("reflectance", reflectance)?,
         })
     }
 }

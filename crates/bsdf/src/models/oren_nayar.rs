@@ -22,12 +22,12 @@ use super::cosine_lobe::{cosine_same_side_pdf, sample_diffuse_reflection};
 use super::microfacet_integral::MicrofacetIntegral;
 use super::to_upper_pair;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
+use crate::error::ParamResult;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
 use crate::microfacet::{Gaussian, Masking, Ndf};
-use crate::recipe::params::check_spectrum;
 
 /// How a model estimates its microfacet integral.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,16 +60,10 @@ impl OrenNayarExact {
         sigma: f64,
         evaluation: IntegralEvaluation,
     ) -> ParamResult<Self> {
-        check_spectrum("reflectance", reflectance, 0.0, 1.0)?;
+        check_reflectance("reflectance", reflectance)?;
         check_range("sigma", sigma, 0.0, 0.5 * PI, Bounds::Open)?;
         if let IntegralEvaluation::Quadrature { samples } = evaluation {
-            if samples < 8 {
-                return Err(ParamError::OutOfRange {
-                    name: "samples".into(),
-                    value: samples as f64,
-                    expected: "samples >= 8".into(),
-                });
-            }
+            check_min_count("samples", samples, 8)?;
         }
         Ok(OrenNayarExact {
             reflectance,
@@ -216,7 +210,7 @@ pub struct OrenNayarQualitative {
 
 impl OrenNayarQualitative {
     pub fn new(reflectance: Spectrum, sigma: f64) -> ParamResult<Self> {
-        check_spectrum("reflectance", reflectance, 0.0, 1.0)?;
+        check_reflectance("reflectance", reflectance)?;
         check_range("sigma", sigma, 0.0, 0.5 * PI, Bounds::ClosedOpen)?;
         let s2 = sigma * sigma;
         Ok(OrenNayarQualitative {

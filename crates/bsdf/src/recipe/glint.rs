@@ -34,9 +34,10 @@
 //! s = [`PIXEL_FOOTPRINT_SIGMA`]. Without derivatives (secondary hits, `facette eval`) it
 //! uses `footprint_size` around the given uv (or `footprint_center`).
 
-use super::params::{check_spectrum, Params};
+use super::params::Params;
 use crate::bsdf::Bsdf;
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{check_range, check_reflectance, Bounds};
+use crate::error::{ParamError, ParamResult};
 use crate::math::spectrum::Spectrum;
 use crate::math::Vec2;
 use crate::models::glint::generate::{generate, NormalMapKind};
@@ -308,11 +309,9 @@ pub fn parse_glint(
         }
     };
     let fresnel = super::material::parse_conductor_fresnel(p)?;
-    let tint = check_spectrum(
+    let tint = check_reflectance(
         "specular_reflectance",
         p.spectrum("specular_reflectance")?.unwrap_or(Spectrum::ONE),
-        0.0,
-        1.0,
     )?;
     let surface = Arc::new(GlintSurface::build(map, floor, label)?);
     Ok(GlintRecipe {

@@ -3,9 +3,12 @@
 
 use super::glint::{parse_glint, GlintRecipe, NormalMapReader, GLINT_KEYS};
 use super::microfacet::{parse_distribution, parse_masking, MICROFACET_KEYS};
-use super::params::{check_spectrum, Params};
+use super::params::Params;
 use crate::bsdf::Bsdf;
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{
+    check_alpha_or_smooth, check_ior, check_range, check_reflectance, check_spectrum, Bounds,
+};
+use crate::error::{ParamError, ParamResult};
 use crate::fresnel::{fresnel_conductor, Fresnel, MetalPreset};
 use crate::math::spectrum::Spectrum;
 use crate::microfacet::half_vector_density::HalfVectorDensity;
@@ -14,7 +17,6 @@ use crate::microfacet::Ndf;
 use crate::models::il_approx::IlApprox;
 use crate::models::il_table::BodyTable;
 use crate::models::interfaced_lambertian::{BodyEvaluation, Scattering};
-use crate::models::kelemen::check_ior;
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::rough_dielectric::{MEASURED_GLASSES, MEASURED_GLASS_IOR};
 use crate::models::smith_microsurface::HeightDistribution;
@@ -407,7 +409,7 @@ impl MaterialRecipe {
                 valid.join(", ")
             ))
         };
-        check_spectrum(key, v, 0.0, 1.0)?;
+        check_reflectance(key, v)?;
         match (self, key) {
             (MaterialRecipe::Lambert { reflectance }, "reflectance")
             | (MaterialRecipe::OrenNayar { reflectance, .. }, "reflectance")
@@ -479,24 +481,34 @@ impl MaterialRecipe {
     }
 }
 
-/// The distribution with one roughness parameter replaced (small values are clamped to the
-/// smallest rough width, 1e-4).
+/// The distribution with one roughness parameter replaced (small widths are clamped to the
+/// smallest rough width, 1e-4). Each value is range-checked once: a width α here (the
+/// constructors then take it as checked), σ and the Phong exponent by their constructors.
 fn with_roughness(ndf: &Ndf, key: &str, v: f64) -> ParamResult<Ndf> {
-    use crate::microfacet::{Beckmann, Gaussian, Ggx, Phong};
-    check_range(key, v, 0.0, 10.0, Bounds::Closed)?;
-    let w = v.max(crate::microfacet::SMOOTH_ALPHA);
+    use crate::microfacet::{Beckmann, Gaussian, Ggx, Phong, SMOOTH_ALPHA};
+    let width = || check_alpha_or_smooth(key, v).map(|a| a.max(SMOOTH_ALPHA));
     Ok(match (ndf, key) {
-        (Ndf::Beckmann(b), "alpha") => Ndf::Beckmann(Beckmann::new(w, w)?.with_g1(b.g1_form())),
+        (Ndf::Beckmann(b), "alpha") => {
+            let w = width()?;
+            Ndf::Beckmann(Beckmann::from_checked(w, w).with_g1(b.g1_form()))
+        }
         (Ndf::Beckmann(b), "alpha_u") => {
-            Ndf::Beckmann(Beckmann::new(w, b.alpha_y())?.with_g1(b.g1_form()))
+            Ndf::Beckmann(Beckmann::from_checked(width()?, b.alpha_y()).with_g1(b.g1_form()))
         }
         (Ndf::Beckmann(b), "alpha_v") => {
-            Ndf::Beckmann(Beckmann::new(b.alpha_x(), w)?.with_g1(b.g1_form()))
+            Ndf::Beckmann(Beckmann::from_checked(b.alpha_x(), width()?).with_g1(b.g1_form()))
         }
-        (Ndf::Ggx(_), "alpha") => Ndf::Ggx(Ggx::new(w, w)?),
-        (Ndf::Ggx(g), "alpha_u") => Ndf::Ggx(Ggx::new(w, g.alpha_y())?),
-        (Ndf::Ggx(g), "alpha_v") => Ndf::Ggx(Ggx::new(g.alpha_x(), w)?),
-        (Ndf::Gaussian(_), "sigma") => Ndf::Gaussian(Gaussian::new(w)?),
+        (Ndf::Ggx(_), "alpha") => {
+            let w = width()?;
+            Ndf::Ggx(Ggx::from_checked(w, w))
+        }
+        (Ndf::Ggx(g), "alpha_u") => Ndf::Ggx(Ggx::from_checked(width()?, g.alpha_y())),
+        (Ndf::Ggx(g), "alpha_v") => Ndf::Ggx(Ggx::from_checked(g.alpha_x(), width()?)),
+        // σ = 0 is the smooth limit, clamped like α; a negative σ must not be clamped.
+        (Ndf::Gaussian(_), "sigma") if v >= 0.0 => {
+            Ndf::Gaussian(Gaussian::new(v.max(SMOOTH_ALPHA))?)
+        }
+        (Ndf::Gaussian(_), "sigma") => Ndf::Gaussian(Gaussian::new(v)?),
         (Ndf::Phong(_), "exponent") => Ndf::Phong(Phong::new(v)?),
         _ => {
             return Err(ParamError::Invalid(format!(
@@ -662,11 +674,9 @@ fn parse_conductor(p: &Params) -> ParamResult<MaterialRecipe> {
         Some(s) => NormalSampling::parse(s)?,
     };
     let fresnel = parse_conductor_fresnel(p)?;
-    let tint = check_spectrum(
+    let tint = check_reflectance(
         "specular_reflectance",
         p.spectrum("specular_reflectance")?.unwrap_or(Spectrum::ONE),
-        0.0,
-        1.0,
     )?;
     p.finish(&keys(CONDUCTOR_KEYS, true))?;
     let lobe = match ndf {
@@ -742,18 +752,14 @@ fn parse_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
             false,
         ),
     };
-    let rt = check_spectrum(
+    let rt = check_reflectance(
         "specular_reflectance",
         p.spectrum("specular_reflectance")?.unwrap_or(Spectrum::ONE),
-        0.0,
-        1.0,
     )?;
-    let tt = check_spectrum(
+    let tt = check_reflectance(
         "specular_transmittance",
         p.spectrum("specular_transmittance")?
             .unwrap_or(Spectrum::ONE),
-        0.0,
-        1.0,
     )?;
     p.finish(&keys(DIELECTRIC_KEYS, true))?;
     let lobe = match ndf {

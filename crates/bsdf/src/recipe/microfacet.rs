@@ -12,7 +12,8 @@
 //! | `sampling` | `visible`, `distribution` | `visible` |
 
 use super::params::Params;
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::check_alpha_or_smooth;
+use crate::error::{ParamError, ParamResult};
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::{
     Beckmann, BeckmannG1, Gaussian, Ggx, Masking, Ndf, Phong, PhongG1, SMOOTH_ALPHA,
@@ -54,8 +55,10 @@ pub fn parse_distribution(p: &Params, allow_smooth: bool) -> ParamResult<Option<
                     ))
                 }
             };
-            check_range("alpha", ax, 0.0, 10.0, Bounds::Closed)?;
-            check_range("alpha", ay, 0.0, 10.0, Bounds::Closed)?;
+            // The one range check of a table's widths: the constructors below take them as
+            // checked.
+            check_alpha_or_smooth("alpha", ax)?;
+            check_alpha_or_smooth("alpha", ay)?;
             if ax < SMOOTH_ALPHA && ay < SMOOTH_ALPHA {
                 if g1.is_some() {
                     return Err(ParamError::Invalid(
@@ -71,14 +74,14 @@ pub fn parse_distribution(p: &Params, allow_smooth: bool) -> ParamResult<Option<
                     "rational" => BeckmannG1::Rational,
                     other => return Err(choice("g1", other, &["exact", "rational"])),
                 };
-                Ndf::Beckmann(Beckmann::new(ax, ay)?.with_g1(form))
+                Ndf::Beckmann(Beckmann::from_checked(ax, ay).with_g1(form))
             } else {
                 if let Some(other) = g1 {
                     if other != "exact" {
                         return Err(choice("g1", other, &["exact"]));
                     }
                 }
-                Ndf::Ggx(Ggx::new(ax, ay)?)
+                Ndf::Ggx(Ggx::from_checked(ax, ay))
             }
         }
         "gaussian" => {

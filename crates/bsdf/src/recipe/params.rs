@@ -172,11 +172,3 @@ impl<'a> Params<'a> {
         Ok(())
     }
 }
-
-/// Checks every component of a spectrum against a range.
-pub fn check_spectrum(name: &str, s: Spectrum, lo: f64, hi: f64) -> ParamResult<Spectrum> {
-    for k in 0..crate::math::spectrum::CHANNELS {
-        crate::error::check_range(name, s[k], lo, hi, crate::error::Bounds::Closed)?;
-    }
-    Ok(s)
-}
