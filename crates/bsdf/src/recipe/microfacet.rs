@@ -11,7 +11,7 @@
 //! | `masking` | `smith`, `smith-correlated`, `v-cavity`, `kelemen` | `smith` (`v-cavity` for gaussian) |
 //! | `sampling` | `visible`, `distribution` | `visible` |
 
-use super::params::Params;
+use super::params::{choice, Params};
 use crate::checks::check_alpha_or_smooth;
 use crate::error::{ParamError, ParamResult};
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
@@ -139,14 +139,6 @@ fn smooth(allow: bool, alpha: f64) -> ParamResult<Option<Ndf>> {
     }
 }
 
-fn choice(what: &str, given: &str, valid: &[&str]) -> ParamError {
-    ParamError::UnknownChoice {
-        what: what.into(),
-        given: given.into(),
-        valid: valid.join(", "),
-    }
-}
-
 /// Reads `masking` (default: `smith`, or `v-cavity` for the Gaussian).
 pub fn parse_masking(p: &Params, ndf: Option<&Ndf>) -> ParamResult<Masking> {
     match p.str("masking")? {
@@ -164,6 +156,43 @@ pub fn parse_sampling(p: &Params) -> ParamResult<NormalSampling> {
         Some(s) => NormalSampling::parse(s),
         None => Ok(NormalSampling::Visible),
     }
+}
+
+/// The distribution with one roughness parameter replaced (small widths are clamped to the
+/// smallest rough width, 1e-4). Each value is range-checked once: a width α here (the
+/// constructors then take it as checked), σ and the Phong exponent by their constructors.
+pub fn with_roughness(ndf: &Ndf, key: &str, v: f64) -> ParamResult<Ndf> {
+    let width = || check_alpha_or_smooth(key, v).map(|a| a.max(SMOOTH_ALPHA));
+    Ok(match (ndf, key) {
+        (Ndf::Beckmann(b), "alpha") => {
+            let w = width()?;
+            Ndf::Beckmann(Beckmann::from_checked(w, w).with_g1(b.g1_form()))
+        }
+        (Ndf::Beckmann(b), "alpha_u") => {
+            Ndf::Beckmann(Beckmann::from_checked(width()?, b.alpha_y()).with_g1(b.g1_form()))
+        }
+        (Ndf::Beckmann(b), "alpha_v") => {
+            Ndf::Beckmann(Beckmann::from_checked(b.alpha_x(), width()?).with_g1(b.g1_form()))
+        }
+        (Ndf::Ggx(_), "alpha") => {
+            let w = width()?;
+            Ndf::Ggx(Ggx::from_checked(w, w))
+        }
+        (Ndf::Ggx(g), "alpha_u") => Ndf::Ggx(Ggx::from_checked(width()?, g.alpha_y())),
+        (Ndf::Ggx(g), "alpha_v") => Ndf::Ggx(Ggx::from_checked(g.alpha_x(), width()?)),
+        // σ = 0 is the smooth limit, clamped like α; a negative σ must not be clamped.
+        (Ndf::Gaussian(_), "sigma") if v >= 0.0 => {
+            Ndf::Gaussian(Gaussian::new(v.max(SMOOTH_ALPHA))?)
+        }
+        (Ndf::Gaussian(_), "sigma") => Ndf::Gaussian(Gaussian::new(v)?),
+        (Ndf::Phong(_), "exponent") => Ndf::Phong(Phong::new(v)?),
+        _ => {
+            return Err(ParamError::Invalid(format!(
+                "`{key}` is not a roughness parameter of {}",
+                crate::microfacet::Distribution::describe(ndf)
+            )))
+        }
+    })
 }
 
 /// Distribution, masking and sampling together; `Ok(None)` for a smooth surface.

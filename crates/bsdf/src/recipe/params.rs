@@ -172,3 +172,12 @@ impl<'a> Params<'a> {
         Ok(())
     }
 }
+
+/// The error of a key whose value is not one of `valid`.
+pub fn choice(what: &str, given: &str, valid: &[&str]) -> ParamError {
+    ParamError::UnknownChoice {
+        what: what.into(),
+        given: given.into(),
+        valid: valid.join(", "),
+    }
+}
