@@ -8,8 +8,10 @@ use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Distribution, Ggx, Masking, Ndf};
-use facette_bsdf::models::albedo_tables::{directional_albedo as table_albedo, TableFresnel};
-use facette_bsdf::models::smith_microsurface::HeightDistribution;
+use facette_bsdf::models::multiple_scattering::albedo_tables::{
+    directional_albedo as table_albedo, TableFresnel,
+};
+use facette_bsdf::models::multiple_scattering::smith_microsurface::HeightDistribution;
 use facette_bsdf::models::{
     MultipleScatteringConductor, MultipleScatteringDielectric, RoughConductor, RoughDielectric,
 };

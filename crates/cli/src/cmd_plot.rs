@@ -6,8 +6,8 @@
 use crate::material_arg::{parse_glint_at, parse_material};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use facette_bsdf::models::il_table::BodyTable;
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_table::BodyTable;
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
 use facette_bsdf::recipe::{parse_inline_table, MaterialRecipe};
 use facette_lab::plot::bsdf_charts::{

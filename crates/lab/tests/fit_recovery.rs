@@ -8,7 +8,7 @@ use facette_bsdf::fresnel::Fresnel;
 use facette_bsdf::math::rng::mix_seed;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Masking, Ndf};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::{InterfacedLambertian, Lambert, RoughConductor};
 use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::{Bsdf, BsdfContext, Spectrum, Vec3};

@@ -5,9 +5,9 @@
 use crate::errors::{os_error, value_error};
 use crate::render::{film_array, options, scene_from};
 use crate::toml_value::table_from_py;
-use facette_bsdf::models::il_table::BodyTable;
-use facette_bsdf::models::il_table_part::{merge_table_parts as merge_tables, TablePart};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_table::BodyTable;
+use facette_bsdf::models::il::il_table_part::{merge_table_parts as merge_tables, TablePart};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
 use facette_bsdf::recipe::microfacet::{parse_distribution, parse_masking, parse_sampling};
 use facette_bsdf::recipe::Params;

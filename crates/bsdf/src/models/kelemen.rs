@@ -30,7 +30,6 @@
 //! | `kd` | matte colour k (number or RGB) | [0, 1] | 0.5 |
 //! | `table_samples` | QMC samples per albedo-table entry | ≥ 64 | 16384 |
 
-use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_reflectance};
 use crate::error::ParamResult;
@@ -39,7 +38,7 @@ use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::hammersley;
-use crate::math::{reflect, Vec3, PI, TWO_PI};
+use crate::math::{flip, reflect, to_upper_pair, Vec3, PI, TWO_PI};
 use crate::microfacet::half_vector_density::HalfVectorDensity;
 
 /// Number of intervals of the albedo table over [0, π/2].

@@ -4,14 +4,13 @@
 //! |---|---|---|---|
 //! | `reflectance` | albedo R (number or RGB) | [0, 1] | 0.5 |
 
-use super::cosine_lobe::{cosine_same_side_pdf, sample_cosine_same_side};
-use super::to_upper_pair;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::check_reflectance;
 use crate::error::ParamResult;
+use crate::math::cosine_lobe::{cosine_same_side_pdf, sample_cosine_same_side};
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::{Vec3, INV_PI};
+use crate::math::{to_upper_pair, Vec3, INV_PI};
 
 #[derive(Clone, Debug)]
 pub struct Lambert {

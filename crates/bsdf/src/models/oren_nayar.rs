@@ -18,15 +18,14 @@
 //! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (N microfacets, deterministic) | — | `quadrature` |
 //! | `samples` | exact, quadrature: microfacets per evaluation | ≥ 8 | 256 |
 
-use super::cosine_lobe::{cosine_same_side_pdf, sample_diffuse_reflection};
-use super::microfacet_integral::MicrofacetIntegral;
-use super::to_upper_pair;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::ParamResult;
+use crate::math::cosine_lobe::{cosine_same_side_pdf, sample_cosine_same_side};
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
-use crate::math::{fmt_num, Vec3, INV_PI, PI};
+use crate::math::{fmt_num, to_upper_pair, Vec3, INV_PI, PI};
+use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::{Gaussian, Masking, Ndf};
 
 /// How a model estimates its microfacet integral.
@@ -50,9 +49,6 @@ pub struct OrenNayarExact {
     integral: MicrofacetIntegral,
     evaluation: IntegralEvaluation,
 }
-
-/// Seed of the frozen quadrature point sets: fixed so that evaluation is deterministic.
-pub(crate) const QUADRATURE_SEED: u64 = 0x005e_ed0f_fac7;
 
 impl OrenNayarExact {
     pub fn new(
@@ -159,6 +155,25 @@ impl Bsdf for OrenNayarExact {
             fmt_num(self.sigma)
         )
     }
+}
+
+/// A diffuse-reflection sample of `bsdf` drawn with the cosine lobe, weighted
+/// f·|cos θ_i|/pdf with f from `bsdf.eval` (which may be a stochastic estimate).
+fn sample_diffuse_reflection(
+    bsdf: &dyn Bsdf,
+    wo: Vec3,
+    ctx: &BsdfContext,
+    rng: &mut dyn RandomSource,
+) -> Option<BsdfSample> {
+    let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
+    let f = bsdf.eval(wo, wi, ctx, rng);
+    Some(BsdfSample {
+        wi,
+        weight: f * (wi.z.abs() / pdf),
+        pdf,
+        lobe: LobeFlags::DIFFUSE_REFLECTION,
+        eta: 1.0,
+    })
 }
 
 /// The scalar factor of Oren & Nayar's L1 model (single scattering, SIGGRAPH 1994, their

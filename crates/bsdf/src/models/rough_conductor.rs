@@ -10,12 +10,11 @@
 //! | `eta`, `k` | complex index per channel (instead of `material`) | η > 0, k ≥ 0 | — |
 //! | `specular_reflectance` | multiplier of the lobe (number or RGB) | [0, 1] | 1 |
 
-use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::Vec3;
+use crate::math::{flip, to_upper_pair, Vec3};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Distribution;
 

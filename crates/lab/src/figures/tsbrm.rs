@@ -12,7 +12,7 @@ use facette_bsdf::fresnel::fresnel_dielectric;
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Gaussian, Masking, Ndf};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::oren_nayar::IntegralEvaluation;
 use facette_bsdf::models::{InterfacedLambertian, OrenNayarExact, OrenNayarQualitative};
 use facette_bsdf::{Bsdf, BsdfContext, ParamError, Spectrum, Vec3};

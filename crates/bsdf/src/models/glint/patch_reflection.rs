@@ -11,8 +11,7 @@ use crate::bsdf::{BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::{reflect, Vec3};
-use crate::models::{flip, to_upper_pair};
+use crate::math::{flip, reflect, to_upper_pair, Vec3};
 
 /// What distinguishes one patch model from another.
 pub(crate) trait PatchReflection {

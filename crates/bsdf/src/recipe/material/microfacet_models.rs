@@ -11,8 +11,8 @@ use crate::fresnel::{fresnel_conductor, Fresnel, MetalPreset};
 use crate::math::spectrum::Spectrum;
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::{Masking, Ndf};
+use crate::models::multiple_scattering::smith_microsurface::HeightDistribution;
 use crate::models::rough_dielectric::{MEASURED_GLASSES, MEASURED_GLASS_IOR};
-use crate::models::smith_microsurface::HeightDistribution;
 use crate::models::{
     CompensatedConductor, CompensatedDielectric, MultipleScatteringConductor,
     MultipleScatteringDielectric, RoughConductor, RoughDielectric,

@@ -25,7 +25,7 @@ use crate::fresnel::Fresnel;
 use crate::math::spectrum::Spectrum;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Ndf;
-use crate::models::interfaced_lambertian::Scattering;
+use crate::models::il::interfaced_lambertian::Scattering;
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::Kelemen;
 use diffuse::{LAMBERT_KEYS, OREN_NAYAR_KEYS};

@@ -20,15 +20,15 @@
 //! is the exact mixture and the weight eval·cos/pdf.
 
 use super::albedo_tables::{table_alpha, AlbedoTable, TableFresnel};
-use super::rough_conductor::RoughConductor;
-use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
 use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
+use crate::math::{flip, to_upper_pair};
 use crate::math::{Vec3, INV_PI, TWO_PI};
 use crate::microfacet::specular_lobe::SpecularLobe;
+use crate::models::rough_conductor::RoughConductor;
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]

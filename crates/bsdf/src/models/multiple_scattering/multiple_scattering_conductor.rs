@@ -21,21 +21,16 @@
 //!   that it is positive wherever a walk can exit.
 
 use super::compensated_conductor::CompensatedConductor;
-use super::rough_conductor::RoughConductor;
+use super::random_walk::{check_lobe, PROXY_COSINE_SHARE};
 use super::smith_microsurface::{FacetScattering, HeightDistribution, Microsurface};
-use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
-use crate::math::{reflect, Vec3};
-use crate::microfacet::specular_lobe::NormalSampling;
-use crate::microfacet::Masking;
-
-/// Share of the cosine density in the MIS proxy.
-pub(crate) const PROXY_COSINE_SHARE: f64 = 1e-3;
+use crate::math::{flip, reflect, to_upper_pair, Vec3};
+use crate::models::rough_conductor::RoughConductor;
 
 /// Mirror facets with a conductor's Fresnel term.
 #[derive(Clone, Debug)]
@@ -144,26 +139,6 @@ impl MultipleScatteringConductor {
             .estimate_with(&self.facets, i, o, min_order, expected_masking, rng)
             / o.z
     }
-}
-
-/// The multiple-scattering models' requirements on the lobe they extend.
-pub(crate) fn check_lobe(masking: Masking, sampling: NormalSampling) -> ParamResult<()> {
-    if masking != Masking::SmithCorrelated {
-        return Err(ParamError::Invalid(format!(
-            "scattering = \"multiple\" walks on the Smith microsurface, whose first order is the \
-             height-correlated Smith masking: use masking = \"smith-correlated\" (the default \
-             with scattering = \"multiple\"), got \"{}\"",
-            masking.name()
-        )));
-    }
-    if sampling != NormalSampling::Visible {
-        return Err(ParamError::Invalid(
-            "scattering = \"multiple\" samples by the random walk, which draws visible normals \
-             (HHdD16): `sampling` does not apply"
-                .into(),
-        ));
-    }
-    Ok(())
 }
 
 impl Bsdf for MultipleScatteringConductor {

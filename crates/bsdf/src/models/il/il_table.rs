@@ -24,12 +24,12 @@
 //! | 8·n_theta²·n_phi | f64 entries, θ_i-major, then θ_o, then φ |
 //! | 4 | u32 CRC-32 (IEEE) of all preceding bytes |
 
-use super::microfacet_integral::MicrofacetIntegral;
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::fresnel_dielectric;
 use crate::math::rng::{mix_seed, Pcg32, RandomSource};
 use crate::math::warp::hammersley;
 use crate::math::{fmt_num, spherical_direction, Vec3, PI};
+use crate::microfacet::integral::MicrofacetIntegral;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Distribution;
 use rayon::prelude::*;

@@ -31,23 +31,21 @@
 //! Flat IL is `evaluation`-independent (closed form). IL with n_i = 1 is the exact
 //! Oren–Nayar model when the distribution is Gaussian with V-cavity masking.
 
-use super::cosine_lobe::sample_cosine_same_side;
 use super::il_approx::IlApprox;
 use super::il_table::BodyTable;
-use super::microfacet_integral::MicrofacetIntegral;
-use super::oren_nayar::QUADRATURE_SEED;
 use super::vcavity::{self, IlFacet, Orders};
-use super::{flip, to_upper_pair};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::{
     external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance,
 };
+use crate::math::cosine_lobe::sample_cosine_same_side;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
-use crate::math::{fmt_num, Vec3, INV_PI};
+use crate::math::{flip, fmt_num, to_upper_pair, Vec3, INV_PI};
+use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
 use std::sync::Arc;
