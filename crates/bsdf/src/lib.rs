@@ -34,6 +34,7 @@ pub mod math;
 pub mod microfacet;
 pub mod models;
 pub mod recipe;
+pub mod two_sided;
 
 pub mod validation;
 

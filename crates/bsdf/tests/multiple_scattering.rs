@@ -16,6 +16,7 @@ use facette_bsdf::models::{
     MultipleScatteringConductor, MultipleScatteringDielectric, RoughConductor, RoughDielectric,
 };
 use facette_bsdf::recipe::{build_material, parse_inline_table};
+use facette_bsdf::two_sided::OpaqueBsdf;
 use facette_bsdf::validation::bsdf_checks::directional_albedo;
 use facette_bsdf::validation::estimator_chi2::{estimator_chi2_test, EstimatorChi2Config};
 use facette_bsdf::validation::suites::{material_suite_matching, SuiteOptions};

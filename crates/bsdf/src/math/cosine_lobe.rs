@@ -4,7 +4,7 @@
 
 use super::rng::RandomSource;
 use super::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
-use super::{flip, to_upper_pair, Vec3};
+use super::{flip, Vec3};
 
 /// A cosine-distributed direction on the side of `wo`, with its solid-angle pdf.
 pub(crate) fn sample_cosine_same_side(wo: Vec3, rng: &mut dyn RandomSource) -> Option<(Vec3, f64)> {
@@ -17,13 +17,4 @@ pub(crate) fn sample_cosine_same_side(wo: Vec3, rng: &mut dyn RandomSource) -> O
     }
     let pdf = cosine_hemisphere_pdf(wi);
     Some((if wo.z < 0.0 { flip(wi) } else { wi }, pdf))
-}
-
-/// The density of [`sample_cosine_same_side`]: |cos θ_i|/π when both directions are on the
-/// same side, 0 otherwise.
-pub(crate) fn cosine_same_side_pdf(wo: Vec3, wi: Vec3) -> f64 {
-    match to_upper_pair(wo, wi) {
-        Some((_, wi)) => cosine_hemisphere_pdf(wi),
-        None => 0.0,
-    }
 }

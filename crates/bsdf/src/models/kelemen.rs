@@ -30,7 +30,7 @@
 //! | `kd` | matte colour k (number or RGB) | [0, 1] | 0.5 |
 //! | `table_samples` | QMC samples per albedo-table entry | ≥ 64 | 16384 |
 
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_reflectance};
 use crate::error::ParamResult;
 use crate::fresnel::Fresnel;
@@ -38,8 +38,9 @@ use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::hammersley;
-use crate::math::{flip, reflect, to_upper_pair, Vec3, PI, TWO_PI};
+use crate::math::{reflect, Vec3, PI, TWO_PI};
 use crate::microfacet::half_vector_density::HalfVectorDensity;
+use crate::two_sided::OpaqueBsdf;
 
 /// Number of intervals of the albedo table over [0, π/2].
 const TABLE_INTERVALS: usize = 90;
@@ -307,16 +308,13 @@ impl Kelemen {
     }
 }
 
-impl Bsdf for Kelemen {
+impl OpaqueBsdf for Kelemen {
     fn flags(&self) -> LobeFlags {
         LobeFlags::GLOSSY_REFLECTION | LobeFlags::DIFFUSE_REFLECTION
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => self.specular(o, i) + self.matte(o, i),
-            None => Spectrum::ZERO,
-        }
+        self.specular(wo, wi) + self.matte(wo, wi)
     }
 
     fn sample(
@@ -325,11 +323,7 @@ impl Bsdf for Kelemen {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
+        let o = wo;
         let ps = self.specular_choice(o);
         let (i, lobe) = if rng.next_f64() < ps {
             (
@@ -348,7 +342,7 @@ impl Bsdf for Kelemen {
         }
         let f = self.specular(o, i) + self.matte(o, i);
         Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
+            wi: i,
             weight: f * (i.z / pdf),
             pdf,
             lobe,
@@ -357,13 +351,8 @@ impl Bsdf for Kelemen {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => {
-                let ps = self.specular_choice(o);
-                ps * self.pdf_specular(o, i) + (1.0 - ps) * self.pdf_matte(i)
-            }
-            None => 0.0,
-        }
+        let ps = self.specular_choice(wo);
+        ps * self.pdf_specular(wo, wi) + (1.0 - ps) * self.pdf_matte(wi)
     }
 
     fn lobe_width(&self) -> f64 {

@@ -34,7 +34,7 @@
 use super::il_approx::IlApprox;
 use super::il_table::BodyTable;
 use super::vcavity::{self, IlFacet, Orders};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::{
@@ -44,10 +44,11 @@ use crate::math::cosine_lobe::sample_cosine_same_side;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
-use crate::math::{flip, fmt_num, to_upper_pair, Vec3, INV_PI};
+use crate::math::{fmt_num, Vec3, INV_PI};
 use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
+use crate::two_sided::OpaqueBsdf;
 use std::sync::Arc;
 
 /// How the body term is evaluated.
@@ -306,7 +307,7 @@ impl InterfacedLambertian {
     }
 }
 
-impl Bsdf for InterfacedLambertian {
+impl OpaqueBsdf for InterfacedLambertian {
     fn flags(&self) -> LobeFlags {
         let spec = if self.lobe.is_some() {
             LobeFlags::GLOSSY_REFLECTION
@@ -323,9 +324,7 @@ impl Bsdf for InterfacedLambertian {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return Spectrum::ZERO;
-        };
+        let (o, i) = (wo, wi);
         let v = self.single(o, i, 1, rng).0 + self.multiple(o, i, rng);
         if v.is_finite() {
             v
@@ -342,9 +341,7 @@ impl Bsdf for InterfacedLambertian {
         samples: usize,
         rng: &mut dyn RandomSource,
     ) -> (Spectrum, Spectrum) {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return (Spectrum::ZERO, Spectrum::ZERO);
-        };
+        let (o, i) = (wo, wi);
         let (single, single_se) = self.single(o, i, samples.max(2), rng);
         if self.scattering == Scattering::Single || self.lobe.is_none() {
             return (single, single_se);
@@ -360,11 +357,7 @@ impl Bsdf for InterfacedLambertian {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
+        let o = wo;
         let ps = self.specular_choice(o);
         let choose_specular = rng.next_f64() < ps;
         let Some(lobe) = &self.lobe else {
@@ -380,11 +373,10 @@ impl Bsdf for InterfacedLambertian {
                 });
             }
             let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
-            let i = if below { flip(wi) } else { wi };
             // f_b cos/((1 − F) cos/π) = K_d T(i)/(n_i²(1 − K_d r_i)).
             return Some(BsdfSample {
                 wi,
-                weight: self.body_factor * self.transmittance(i.z),
+                weight: self.body_factor * self.transmittance(wi.z),
                 pdf: (1.0 - ps) * pdf,
                 lobe: LobeFlags::DIFFUSE_REFLECTION,
                 eta: 1.0,
@@ -409,7 +401,7 @@ impl Bsdf for InterfacedLambertian {
             return None;
         }
         Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
+            wi: i,
             weight,
             pdf,
             lobe: lobe_flag,
@@ -418,9 +410,7 @@ impl Bsdf for InterfacedLambertian {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return 0.0;
-        };
+        let (o, i) = (wo, wi);
         let ps = self.specular_choice(o);
         let spec = match &self.lobe {
             Some(l) => ps * l.pdf(o, i),

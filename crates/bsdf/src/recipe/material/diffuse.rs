@@ -8,6 +8,7 @@ use crate::math::spectrum::Spectrum;
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::{Lambert, OrenNayarExact, OrenNayarQualitative};
 use crate::recipe::params::{choice, Params};
+use crate::two_sided::TwoSided;
 use std::sync::Arc;
 
 pub(super) const LAMBERT_KEYS: &[&str] = &["reflectance"];
@@ -78,7 +79,7 @@ pub(super) fn parse_oren_nayar(p: &Params) -> ParamResult<MaterialRecipe> {
 }
 
 pub(super) fn build_lambert(reflectance: Spectrum) -> ParamResult<Arc<dyn Bsdf>> {
-    Ok(Arc::new(Lambert::new(reflectance)?))
+    Ok(Arc::new(TwoSided::new(Lambert::new(reflectance)?)))
 }
 
 /// Oren–Nayar; σ = 0 is Lambert.
@@ -92,8 +93,17 @@ pub(super) fn build_oren_nayar(
         return build_lambert(reflectance);
     }
     Ok(match model {
-        OrenNayarModel::Exact => Arc::new(OrenNayarExact::new(reflectance, sigma, evaluation)?),
-        OrenNayarModel::Qualitative => Arc::new(OrenNayarQualitative::new(reflectance, sigma)?),
-        OrenNayarModel::L1 => Arc::new(OrenNayarQualitative::l1(reflectance, sigma)?),
+        OrenNayarModel::Exact => Arc::new(TwoSided::new(OrenNayarExact::new(
+            reflectance,
+            sigma,
+            evaluation,
+        )?)),
+        OrenNayarModel::Qualitative => Arc::new(TwoSided::new(OrenNayarQualitative::new(
+            reflectance,
+            sigma,
+        )?)),
+        OrenNayarModel::L1 => {
+            Arc::new(TwoSided::new(OrenNayarQualitative::l1(reflectance, sigma)?))
+        }
     })
 }

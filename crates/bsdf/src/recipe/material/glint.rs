@@ -46,6 +46,7 @@ use crate::models::glint::{
     Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap, PointReferenceBsdf,
 };
 use crate::recipe::params::Params;
+use crate::two_sided::TwoSided;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -137,18 +138,19 @@ impl GlintRecipe {
     pub fn build_at(&self, uv: Vec2, derivs: [f64; 4]) -> Arc<dyn Bsdf> {
         if self.reference {
             let center = self.footprint_at(uv, [0.0; 4]).center;
-            return Arc::new(PointReferenceBsdf::new(
+            return Arc::new(TwoSided::new(PointReferenceBsdf::new(
                 self.surface.map(),
                 center,
                 self.surface.roughness_floor(),
                 self.params.fresnel,
                 self.params.tint,
-            ));
+            )));
         }
-        Arc::new(self.bsdf_at(uv, derivs))
+        Arc::new(TwoSided::new(self.bsdf_at(uv, derivs)))
     }
 
-    /// The concrete BSDF of a shading point.
+    /// The concrete model of a shading point, for the upper hemisphere (what
+    /// [`build_at`](Self::build_at) wraps in [`TwoSided`]).
     pub fn bsdf_at(&self, uv: Vec2, derivs: [f64; 4]) -> GlintBsdf {
         GlintBsdf::new(
             self.surface.clone(),

@@ -14,6 +14,7 @@ use crate::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use crate::models::InterfacedLambertian;
 use crate::recipe::microfacet::{parse_distribution, parse_masking};
 use crate::recipe::params::{choice, Params};
+use crate::two_sided::TwoSided;
 use std::sync::Arc;
 
 pub(super) const IL_KEYS: &[&str] = &["kd", "ni", "evaluation", "samples", "table", "scattering"];
@@ -112,11 +113,11 @@ pub(super) fn build_il(
             None => BodyEvaluation::Stochastic,
         },
     };
-    Ok(Arc::new(InterfacedLambertian::new(
+    Ok(Arc::new(TwoSided::new(InterfacedLambertian::new(
         kd,
         ni,
         lobe.clone(),
         ev,
         scattering,
-    )?))
+    )?)))
 }

@@ -19,6 +19,7 @@ use crate::models::{
 };
 use crate::recipe::microfacet::{parse_distribution, parse_masking};
 use crate::recipe::params::{choice, Params};
+use crate::two_sided::TwoSided;
 use std::sync::Arc;
 
 pub(super) const CONDUCTOR_KEYS: &[&str] = &[
@@ -266,10 +267,12 @@ pub(super) fn build_conductor(
     let single = RoughConductor::new(lobe.clone(), fresnel, tint);
     Ok(match (energy, lobe) {
         (MicrofacetEnergy::Multiple(h), Some(_)) => {
-            Arc::new(MultipleScatteringConductor::new(single, h)?)
+            Arc::new(TwoSided::new(MultipleScatteringConductor::new(single, h)?))
         }
-        (MicrofacetEnergy::Compensated, Some(_)) => Arc::new(CompensatedConductor::new(single)?),
-        _ => Arc::new(single),
+        (MicrofacetEnergy::Compensated, Some(_)) => {
+            Arc::new(TwoSided::new(CompensatedConductor::new(single)?))
+        }
+        _ => Arc::new(TwoSided::new(single)),
     })
 }
 

@@ -28,6 +28,7 @@ use crate::microfacet::Ndf;
 use crate::models::il::interfaced_lambertian::Scattering;
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::Kelemen;
+use crate::two_sided::TwoSided;
 use diffuse::{LAMBERT_KEYS, OREN_NAYAR_KEYS};
 use glint::{parse_glint, GlintRecipe, NormalMapReader, GLINT_KEYS};
 use il::IL_KEYS;
@@ -216,7 +217,9 @@ impl MaterialRecipe {
                 (*reflect_tint, *transmit_tint),
                 *energy,
             ),
-            MaterialRecipe::Kelemen(k) => Ok(k.clone()),
+            // The recipe keeps the model (its tables are shared by textured copies); the
+            // BSDF is its two-sided view.
+            MaterialRecipe::Kelemen(k) => Ok(Arc::new(TwoSided::new(Kelemen::clone(k)))),
             MaterialRecipe::Il {
                 kd,
                 ni,
