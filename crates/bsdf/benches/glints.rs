@@ -18,6 +18,7 @@ use facette_bsdf::models::glint::patch_ndf::PatchNdf;
 use facette_bsdf::models::glint::{
     generate, Footprint, GlintBsdf, GlintParams, GlintSurface, MaskingMode, NormalMapKind,
 };
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, Vec2, Vec3};
 use std::sync::{Arc, OnceLock};
 
@@ -181,10 +182,16 @@ fn glint_bsdf(c: &mut Criterion) {
             masking: mode,
             masking_lobes: DEFAULT_MASKING_LOBES,
         };
-        let bsdfs: Vec<GlintBsdf> = centres()
+        let bsdfs: Vec<TwoSided<GlintBsdf>> = centres()
             .into_iter()
             .take(16)
-            .map(|c| GlintBsdf::new(surf.clone(), Footprint::isotropic(c, 4.0), &params))
+            .map(|c| {
+                TwoSided::new(GlintBsdf::new(
+                    surf.clone(),
+                    Footprint::isotropic(c, 4.0),
+                    &params,
+                ))
+            })
             .collect();
         let mut g = c.benchmark_group(format!("glint-scratched-{SIZE}-sigma-4-{mode_name}"));
         g.throughput(Throughput::Elements(256));

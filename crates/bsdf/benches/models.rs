@@ -5,7 +5,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::{BsdfContext, Vec3};
 
 const MODELS: &[(&str, &str)] = &[
@@ -107,7 +107,7 @@ fn models(c: &mut Criterion) {
             NormalSampling::Visible,
         )
         .unwrap();
-        facette_bsdf::models::il_table::BodyTable::build(&lobe, 1.5, 5.0, 10_000, &|_, _| {})
+        facette_bsdf::models::il::il_table::BodyTable::build(&lobe, 1.5, 5.0, 10_000, &|_, _| {})
             .unwrap()
             .save(&table_path)
             .unwrap();
@@ -185,7 +185,7 @@ fn il_tables(c: &mut Criterion) {
         g.bench_function(format!("step-{step}deg-10000-samples"), |b| {
             b.iter(|| {
                 black_box(
-                    facette_bsdf::models::il_table::BodyTable::build(
+                    facette_bsdf::models::il::il_table::BodyTable::build(
                         &lobe,
                         1.2,
                         step,
@@ -204,7 +204,7 @@ fn il_tables(c: &mut Criterion) {
 /// the conductor's (F = 1) and the dielectric's (η = 1.5 and 1/1.5, both sides).
 fn albedo_tables(c: &mut Criterion) {
     use facette_bsdf::microfacet::{Ggx, Masking, Ndf};
-    use facette_bsdf::models::albedo_tables::{AlbedoTable, TableFresnel};
+    use facette_bsdf::models::multiple_scattering::albedo_tables::{AlbedoTable, TableFresnel};
     let ndf = Ndf::Ggx(Ggx::isotropic(0.3).unwrap());
     let mut g = c.benchmark_group("albedo-table-build");
     g.sample_size(10);

@@ -2,7 +2,7 @@
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::{Beckmann, Distribution};
-use facette_bsdf::models::vcavity::{walk, IlFacet};
+use facette_bsdf::models::il::vcavity::{walk, IlFacet};
 use facette_bsdf::Spectrum;
 fn main() {
     let ni = 1.5;

@@ -10,11 +10,12 @@
 //!   Phong, with Smith Λ/G1, samplers of D(m)|m·n| and of visible normals; masking choices;
 //!   KSK01's half-vector densities; the shared specular microfacet lobe.
 //! - [`fresnel`]: exact dielectric and conductor Fresnel, Schlick, r_e and r_i.
+//! - [`checks`]: the valid range of every shared parameter, defined once.
 //! - [`bsdf`]: the BSDF interface (`eval`, `sample`, `pdf`, flags, transport mode,
 //!   stochastic evaluation).
 //! - [`models`]: one file per model.
-//! - [`spec`]: materials written as TOML tables (`{type = "dielectric", …}`), validated and
-//!   built into BSDFs.
+//! - [`recipe`]: materials written as TOML tables (`{type = "dielectric", …}`), parsed and
+//!   validated into recipes (`MaterialRecipe`), which build BSDFs.
 //! - [`storage`]: the atomic file writer and the framed binary container that every
 //!   file facette writes goes through.
 //! - [`validation`]: chi-square goodness of fit, normalization, reciprocity, energy and
@@ -28,13 +29,15 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bsdf;
+pub mod checks;
 pub mod error;
 pub mod fresnel;
 pub mod math;
 pub mod microfacet;
 pub mod models;
-pub mod spec;
+pub mod recipe;
 pub mod storage;
+pub mod two_sided;
 
 pub mod validation;
 

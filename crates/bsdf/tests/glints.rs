@@ -14,7 +14,8 @@ use facette_bsdf::models::glint::reference::{
 use facette_bsdf::models::glint::{
     generate, GlintBsdf, GlintParams, GlintSurface, NormalMap, NormalMapKind,
 };
-use facette_bsdf::spec::{build_material, parse_inline_table, MaterialRecipe};
+use facette_bsdf::recipe::{build_material, parse_inline_table, MaterialRecipe};
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, Spectrum, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -128,11 +129,11 @@ fn flat_map_gives_a_beckmann_lobe_of_the_roughness_floor() {
         let surf = Arc::new(GlintSurface::build(map, floor, "flat").unwrap());
         let b = Beckmann::isotropic(floor * std::f64::consts::SQRT_2).unwrap();
         for sigma in [0.0, 3.0, 100.0] {
-            let bsdf = GlintBsdf::new(
+            let bsdf = TwoSided::new(GlintBsdf::new(
                 surf.clone(),
                 Footprint::isotropic(Vec2::new(3.0, 4.0), sigma),
                 &white(MaskingMode::Exact),
-            );
+            ));
             let ndf = bsdf.ndf();
             let mut worst: f64 = 0.0;
             for k in 0..200 {
@@ -282,7 +283,7 @@ fn exact_masking_above_the_budget_uses_coarser_levels() {
 /// Directional albedo of `bsdf` at `wo` by its own sampler, with the renderer's cos θ_i and
 /// with the patch's visible projected area I_P(i) (CCM19 eq. 7 conserves the latter):
 /// (mean, standard error) of each.
-fn albedos(bsdf: &GlintBsdf, wo: Vec3, n: usize, seed: u64) -> ([f64; 2], [f64; 2]) {
+fn albedos(bsdf: &TwoSided<GlintBsdf>, wo: Vec3, n: usize, seed: u64) -> ([f64; 2], [f64; 2]) {
     use rayon::prelude::*;
     const CHUNKS: usize = 16;
     let per = n / CHUNKS;
@@ -332,11 +333,11 @@ fn energy_is_bounded_and_the_cosine_question_is_measured() {
     for kind in KINDS {
         let surf = surface(kind, size, 0.01);
         for sigma in [0.5, 3.0, 12.0] {
-            let bsdf = GlintBsdf::new(
+            let bsdf = TwoSided::new(GlintBsdf::new(
                 surf.clone(),
                 Footprint::isotropic(Vec2::new(20.5, 7.5), sigma),
                 &params,
-            );
+            ));
             let mean = bsdf.masking().filtered_lobe().mean;
             // Large footprints cost ~ their area per query: normal incidence only.
             let angles: &[f64] = if sigma >= 12.0 {

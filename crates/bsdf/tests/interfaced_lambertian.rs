@@ -5,10 +5,10 @@ use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Gaussian, Masking, Ndf};
-use facette_bsdf::models::il_table::BodyTable;
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_table::BodyTable;
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::validation::measurements::hemispherical_reflectance;
 use facette_bsdf::{Bsdf, BsdfContext, Spectrum, Vec3};
 use std::sync::Arc;
@@ -301,7 +301,7 @@ fn bad_parameters_are_clear_errors() {
 
 #[test]
 fn approximation_has_the_exact_limits_and_bounded_error() {
-    use facette_bsdf::models::il_approx::{ApproxFamily, IlApprox};
+    use facette_bsdf::models::il::il_approx::{ApproxFamily, IlApprox};
     use facette_bsdf::models::oren_nayar::oren_nayar_l1_factor;
     // σ → 0: flat IL, for every family and index.
     let mut rng = Pcg32::new(5, 5);
@@ -342,11 +342,11 @@ fn approximation_has_the_exact_limits_and_bounded_error() {
 
 /// Mean relative error of the approximation against the quadrature over θ ≤ 75°.
 fn facette_lab_free_accuracy(
-    fam: facette_bsdf::models::il_approx::ApproxFamily,
+    fam: facette_bsdf::models::il::il_approx::ApproxFamily,
     sigma: f64,
     ni: f64,
 ) -> f64 {
-    use facette_bsdf::models::il_approx::{ApproxFamily, IlApprox};
+    use facette_bsdf::models::il::il_approx::{ApproxFamily, IlApprox};
     let lobe = match fam {
         ApproxFamily::GaussianVCavity => gaussian_il_lobe(sigma),
         _ => SpecularLobe::new(

@@ -3,7 +3,7 @@
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::models::Kelemen;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::validation::measurements::{
     dielectric_max_weight, mean_weight, oren_nayar_error,
 };

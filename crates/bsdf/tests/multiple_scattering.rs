@@ -8,12 +8,15 @@ use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Distribution, Ggx, Masking, Ndf};
-use facette_bsdf::models::albedo_tables::{directional_albedo as table_albedo, TableFresnel};
-use facette_bsdf::models::smith_microsurface::HeightDistribution;
+use facette_bsdf::models::multiple_scattering::albedo_tables::{
+    directional_albedo as table_albedo, TableFresnel,
+};
+use facette_bsdf::models::multiple_scattering::smith_microsurface::HeightDistribution;
 use facette_bsdf::models::{
     MultipleScatteringConductor, MultipleScatteringDielectric, RoughConductor, RoughDielectric,
 };
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
+use facette_bsdf::two_sided::OpaqueBsdf;
 use facette_bsdf::validation::bsdf_checks::directional_albedo;
 use facette_bsdf::validation::estimator_chi2::{estimator_chi2_test, EstimatorChi2Config};
 use facette_bsdf::validation::suites::{material_suite_matching, SuiteOptions};

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
-use facette_bsdf::models::il_approx::ApproxFamily;
+use facette_bsdf::models::il::il_approx::ApproxFamily;
 use facette_lab::il_approx_fit::{accuracy, coefficients_source, fit_family};
 use std::process::ExitCode;
 

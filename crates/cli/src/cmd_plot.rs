@@ -6,10 +6,10 @@
 use crate::material_arg::{parse_glint_at, parse_material};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use facette_bsdf::models::il_table::BodyTable;
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_table::BodyTable;
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
-use facette_bsdf::spec::{parse_inline_table, MaterialRecipe};
+use facette_bsdf::recipe::{parse_inline_table, MaterialRecipe};
 use facette_lab::plot::bsdf_charts::{
     albedo_chart, chart_csv, hemisphere_chart, polar_from_slice, slice_chart, summarize,
     LabelledBsdf, SliceOptions,

@@ -6,11 +6,11 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::math::spherical_direction;
-use facette_bsdf::models::il_table::BodyTable;
-use facette_bsdf::models::il_table_part::{merge_table_parts, TablePart};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_table::BodyTable;
+use facette_bsdf::models::il::il_table_part::{merge_table_parts, TablePart};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
-use facette_bsdf::spec::{parse_inline_table, Params};
+use facette_bsdf::recipe::{parse_inline_table, Params};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
@@ -44,7 +44,7 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
     if ty != "il" && ty != "interfaced-lambertian" {
         bail!("--material: tabulate needs an interfaced-Lambertian material (type = \"il\"), got type `{ty}`");
     }
-    let bsdf = facette_bsdf::spec::build_material(&table).context("--material")?;
+    let bsdf = facette_bsdf::recipe::build_material(&table).context("--material")?;
     let _ = Params::new(&table, "material");
     // Rebuild the concrete model to reach its microfacet lobe.
     let il = match (bsdf.describe(), find_il(&table)?) {
@@ -150,7 +150,7 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
 /// The rough IL model described by `table` (None when flat).
 fn find_il(table: &toml::Table) -> Result<Option<InterfacedLambertian>> {
     use facette_bsdf::microfacet::specular_lobe::SpecularLobe;
-    use facette_bsdf::spec::microfacet::{parse_distribution, parse_masking, parse_sampling};
+    use facette_bsdf::recipe::microfacet::{parse_distribution, parse_masking, parse_sampling};
     let p = Params::new(table, "material \"il\"");
     let kd = p
         .spectrum("kd")?

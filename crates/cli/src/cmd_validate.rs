@@ -3,8 +3,8 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use facette_bsdf::spec::microfacet::{parse_distribution, MICROFACET_KEYS};
-use facette_bsdf::spec::{parse_inline_table, Params};
+use facette_bsdf::recipe::microfacet::{parse_distribution, MICROFACET_KEYS};
+use facette_bsdf::recipe::{parse_inline_table, Params};
 use facette_bsdf::validation::bsdf_checks::{check_bsdf, BsdfCheckOptions};
 use facette_bsdf::validation::chi2::Chi2Config;
 use facette_bsdf::validation::distribution_checks::{check_distribution, DistributionCheckOptions};

@@ -3,7 +3,8 @@
 
 use anyhow::{bail, Context, Result};
 use facette_bsdf::models::glint::GlintBsdf;
-use facette_bsdf::spec::{build_material_with_reader, parse_inline_table, MaterialRecipe};
+use facette_bsdf::recipe::{build_material_with_reader, parse_inline_table, MaterialRecipe};
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, Vec2};
 use facette_render::image::ImageNormalMapReader;
 use std::sync::Arc;
@@ -22,8 +23,9 @@ pub fn parse_material_at(text: &str, footprint: Option<&str>) -> Result<Arc<dyn 
 }
 
 /// Parses a glint `--material` (with an optional `--footprint`) into the concrete P-BRDF of
-/// that footprint; any other material type is an error that says which one it got.
-pub fn parse_glint_at(text: &str, footprint: Option<&str>) -> Result<GlintBsdf> {
+/// that footprint (two-sided; its own methods through the adapter); any other material type
+/// is an error that says which one it got.
+pub fn parse_glint_at(text: &str, footprint: Option<&str>) -> Result<TwoSided<GlintBsdf>> {
     let ty = parse_inline_table(text)
         .context("--material")?
         .get("type")
@@ -44,7 +46,9 @@ pub fn parse_glint_at(text: &str, footprint: Option<&str>) -> Result<GlintBsdf> 
     let MaterialRecipe::Glint(g) = recipe else {
         bail!("--material: a patch NDF needs a `type = \"glint\"` material");
     };
-    Ok(g.bsdf_at(Vec2::from(g.footprint_center), [0.0; 4]))
+    Ok(TwoSided::new(
+        g.bsdf_at(Vec2::from(g.footprint_center), [0.0; 4]),
+    ))
 }
 
 /// The `--material` table with `--footprint` applied as `footprint_center` and

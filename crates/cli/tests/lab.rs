@@ -307,7 +307,7 @@ fn plot_errors_are_clear_and_write_nothing() {
 mod fit {
     use super::*;
     use facette_bsdf::math::rng::{mix_seed, Pcg32};
-    use facette_bsdf::spec::{build_material, parse_inline_table};
+    use facette_bsdf::recipe::{build_material, parse_inline_table};
     use facette_bsdf::BsdfContext;
     use facette_lab::merl::MerlBrdf;
 

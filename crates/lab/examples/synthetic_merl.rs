@@ -6,7 +6,7 @@
 //!     white-paint-like.binary [NOISE] [SEED]
 
 use facette_bsdf::math::rng::Pcg32;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::BsdfContext;
 use facette_lab::merl::MerlBrdf;
 

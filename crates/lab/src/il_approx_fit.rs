@@ -1,6 +1,6 @@
 //! The fitting program of the approximate interfaced-Lambertian body term (IL18 §4.2,
 //! rebuilt because its appendix is missing — ERRATA 1). `facette il-approx fit` runs it and
-//! regenerates `crates/bsdf/src/models/il_approx_coefficients.rs`; `facette il-approx
+//! regenerates `crates/bsdf/src/models/il/il_approx_coefficients.rs`; `facette il-approx
 //! accuracy` measures the result against the quadrature.
 //!
 //! For every node of the (σ, n_i) grid of a family (Gaussian/V-cavity, Beckmann/V-cavity,
@@ -18,11 +18,11 @@ use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::{spherical_direction, Vec3};
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Gaussian, Masking, Ndf};
-use facette_bsdf::models::il_approx::{
+use facette_bsdf::models::il::il_approx::{
     approx_integral, ApproxCoefficients, ApproxFamily, IlApprox,
 };
-use facette_bsdf::models::il_approx_coefficients::{NI_NODES, SIGMA_NODES};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_approx_coefficients::{NI_NODES, SIGMA_NODES};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
 use facette_bsdf::Spectrum;
 use rayon::prelude::*;

@@ -34,7 +34,7 @@ pub fn measure_material(material: &dyn Bsdf, noise: f64, seed: u64) -> MerlBrdf 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use facette_bsdf::spec::{build_material, parse_inline_table};
+    use facette_bsdf::recipe::{build_material, parse_inline_table};
     use std::f64::consts::FRAC_1_PI;
 
     #[test]

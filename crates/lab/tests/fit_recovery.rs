@@ -8,9 +8,10 @@ use facette_bsdf::fresnel::Fresnel;
 use facette_bsdf::math::rng::mix_seed;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Masking, Ndf};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::{InterfacedLambertian, Lambert, RoughConductor};
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, Spectrum, Vec3};
 use facette_lab::fit::{
     fit, select_samples, ErrorMetric, FitReport, IlDistribution, IlFamily, IlFitEvaluation,
@@ -68,14 +69,16 @@ fn il_parameters_are_recovered() {
         NormalSampling::Visible,
     )
     .unwrap();
-    let il = InterfacedLambertian::new(
-        kd,
-        ni,
-        Some(lobe),
-        BodyEvaluation::Quadrature { samples: 512 },
-        Scattering::Single,
-    )
-    .unwrap();
+    let il = TwoSided::new(
+        InterfacedLambertian::new(
+            kd,
+            ni,
+            Some(lobe),
+            BodyEvaluation::Quadrature { samples: 512 },
+            Scattering::Single,
+        )
+        .unwrap(),
+    );
     let clean = synthetic(|i, o| eval(&il, i, o));
     let family = IlFamily::new(IlDistribution::Beckmann, IlFitEvaluation::Quadrature(64));
     for (merl, tol) in [
@@ -94,18 +97,18 @@ fn il_parameters_are_recovered() {
 #[test]
 fn plastic_parameters_are_recovered() {
     let (kd, ks, alpha) = (Spectrum::rgb(0.2, 0.5, 0.3), 0.8, 0.15);
-    let lambert = Lambert::new(kd).unwrap();
+    let lambert = TwoSided::new(Lambert::new(kd).unwrap());
     let lobe = SpecularLobe::new(
         Ndf::Beckmann(Beckmann::isotropic(alpha).unwrap()),
         Masking::SmithSeparable,
         NormalSampling::Visible,
     )
     .unwrap();
-    let spec = RoughConductor::new(
+    let spec = TwoSided::new(RoughConductor::new(
         Some(lobe),
         Fresnel::Dielectric { eta: 1.5 },
         Spectrum::splat(ks),
-    );
+    ));
     let clean = synthetic(|i, o| eval(&lambert, i, o) + eval(&spec, i, o));
     let family = PlasticFamily { ggx: false };
     for (merl, tol) in [

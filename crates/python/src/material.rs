@@ -65,7 +65,7 @@ impl Material {
     #[new]
     fn new(spec: &Bound<'_, PyAny>) -> PyResult<Self> {
         let table = table_from_py(spec)?;
-        let bsdf = facette_bsdf::spec::build_material(&table).map_err(value_error)?;
+        let bsdf = facette_bsdf::recipe::build_material(&table).map_err(value_error)?;
         Ok(Material { bsdf })
     }
 

@@ -5,12 +5,12 @@
 use crate::errors::{os_error, value_error};
 use crate::render::{film_array, options, scene_from};
 use crate::toml_value::table_from_py;
-use facette_bsdf::models::il_table::BodyTable;
-use facette_bsdf::models::il_table_part::{merge_table_parts as merge_tables, TablePart};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_table::BodyTable;
+use facette_bsdf::models::il::il_table_part::{merge_table_parts as merge_tables, TablePart};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
-use facette_bsdf::spec::microfacet::{parse_distribution, parse_masking, parse_sampling};
-use facette_bsdf::spec::Params;
+use facette_bsdf::recipe::microfacet::{parse_distribution, parse_masking, parse_sampling};
+use facette_bsdf::recipe::Params;
 use facette_render::partial_film::{merge_parts, PartialFilm};
 use numpy::{IntoPyArray, PyArray3};
 use pyo3::prelude::*;
@@ -105,7 +105,7 @@ fn il_lobe(
             "tabulate needs an interfaced-Lambertian material (type = \"il\"), got type `{ty}`"
         )));
     }
-    facette_bsdf::spec::build_material(&table).map_err(value_error)?;
+    facette_bsdf::recipe::build_material(&table).map_err(value_error)?;
     let p = Params::new(&table, "material \"il\"");
     let ni = p.f64_or("ni", 1.5).map_err(value_error)?;
     let ndf = parse_distribution(&p, true)

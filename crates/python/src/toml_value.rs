@@ -9,7 +9,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 pub fn table_from_py(spec: &Bound<'_, PyAny>) -> PyResult<toml::Table> {
     if let Ok(s) = spec.cast::<PyString>() {
         let text: String = s.extract()?;
-        return facette_bsdf::spec::parse_inline_table(&text).map_err(value_error);
+        return facette_bsdf::recipe::parse_inline_table(&text).map_err(value_error);
     }
     if let Ok(d) = spec.cast::<PyDict>() {
         return dict_to_table(d, "material");

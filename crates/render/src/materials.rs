@@ -15,7 +15,7 @@
 //! default (`encoding` overrides). A roughness texture's value is its channel average.
 
 use crate::image::{read_image, ColorEncoding, ImageNormalMapReader, MipMap, Texture, WrapMode};
-use facette_bsdf::spec::MaterialRecipe;
+use facette_bsdf::recipe::MaterialRecipe;
 use facette_bsdf::{Bsdf, Spectrum};
 use glam::DVec2;
 use std::path::Path;

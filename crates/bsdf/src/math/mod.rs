@@ -8,6 +8,7 @@
 //! the checks that prove it.
 
 pub mod complex;
+pub(crate) mod cosine_lobe;
 pub mod quadrature;
 pub mod rng;
 pub mod special;
@@ -146,6 +147,28 @@ pub fn fmt_num(x: f64) -> String {
 #[inline]
 pub fn is_unit(v: Vec3) -> bool {
     v.is_finite() && (v.length_squared() - 1.0).abs() < 1e-6
+}
+
+/// Mirror image through the tangent plane.
+#[inline]
+pub fn flip(v: Vec3) -> Vec3 {
+    Vec3::new(v.x, v.y, -v.z)
+}
+
+/// A pair of directions seen from the upper hemisphere: unchanged when `wo` is above the
+/// surface, both mirrored through the tangent plane when it is below; `None` when the two
+/// are on opposite sides (or in the tangent plane). The geometry of
+/// [`TwoSided`](crate::two_sided::TwoSided).
+#[inline]
+pub fn to_upper_pair(wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
+    if wo.z * wi.z <= 0.0 {
+        return None;
+    }
+    if wo.z > 0.0 {
+        Some((wo, wi))
+    } else {
+        Some((flip(wo), flip(wi)))
+    }
 }
 
 #[cfg(test)]

@@ -8,7 +8,8 @@
 //! IL18 eq. 16 calls the widths σ_x, σ_y; they are WMLT07's α_b (ERRATA 6).
 
 use super::{normal_from_slopes, Distribution};
-use crate::error::{check_range, Bounds, ParamResult};
+use crate::checks::check_alpha;
+use crate::error::ParamResult;
 use crate::math::special::{erf, erfc, erfinv_approx, erfinv_of_uniform};
 use crate::math::{fmt_num, Vec2, Vec3, PI, SQRT_PI, TWO_PI};
 
@@ -37,9 +38,15 @@ pub struct Beckmann {
 impl Beckmann {
     /// Anisotropic Beckmann; both widths in (0, 10].
     pub fn new(alpha_x: f64, alpha_y: f64) -> ParamResult<Self> {
-        check_range("alpha_u", alpha_x, 0.0, 10.0, Bounds::OpenClosed)?;
-        check_range("alpha_v", alpha_y, 0.0, 10.0, Bounds::OpenClosed)?;
-        Ok(Self::from_alphas(alpha_x, alpha_y, BeckmannG1::Exact))
+        check_alpha("alpha_u", alpha_x)?;
+        check_alpha("alpha_v", alpha_y)?;
+        Ok(Self::from_checked(alpha_x, alpha_y))
+    }
+
+    /// Anisotropic Beckmann from widths the caller has already checked (a material recipe
+    /// checks them once, with the smooth limit).
+    pub(crate) fn from_checked(alpha_x: f64, alpha_y: f64) -> Self {
+        Self::from_alphas(alpha_x, alpha_y, BeckmannG1::Exact)
     }
 
     fn from_alphas(ax: f64, ay: f64, g1_form: BeckmannG1) -> Self {
@@ -56,8 +63,8 @@ impl Beckmann {
     }
 
     pub fn isotropic(alpha: f64) -> ParamResult<Self> {
-        check_range("alpha", alpha, 0.0, 10.0, Bounds::OpenClosed)?;
-        Self::new(alpha, alpha)
+        check_alpha("alpha", alpha)?;
+        Ok(Self::from_checked(alpha, alpha))
     }
 
     pub fn with_g1(mut self, form: BeckmannG1) -> Self {

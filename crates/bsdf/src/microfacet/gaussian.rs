@@ -19,7 +19,8 @@
 //! with an error that says so, and `lambda` reports +∞ (G1 = 0).
 
 use super::{ggx::Ggx, Distribution};
-use crate::error::{check_range, Bounds, ParamResult};
+use crate::checks::{check_range, Bounds};
+use crate::error::ParamResult;
 use crate::math::quadrature::integrate_adaptive;
 use crate::math::{fmt_num, Vec2, Vec3, PI};
 

@@ -10,7 +10,8 @@
 //! θ_m uses the second, independent number.
 
 use super::{normal_from_slopes, visible_density, Distribution};
-use crate::error::{check_range, Bounds, ParamResult};
+use crate::checks::check_alpha;
+use crate::error::ParamResult;
 use crate::math::{fmt_num, Vec2, Vec3, PI, TWO_PI};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,9 +28,15 @@ pub struct Ggx {
 
 impl Ggx {
     pub fn new(alpha_x: f64, alpha_y: f64) -> ParamResult<Self> {
-        check_range("alpha_u", alpha_x, 0.0, 10.0, Bounds::OpenClosed)?;
-        check_range("alpha_v", alpha_y, 0.0, 10.0, Bounds::OpenClosed)?;
+        check_alpha("alpha_u", alpha_x)?;
+        check_alpha("alpha_v", alpha_y)?;
         Ok(Self::from_alphas(alpha_x, alpha_y))
+    }
+
+    /// Anisotropic GGX from widths the caller has already checked (a material recipe
+    /// checks them once, with the smooth limit).
+    pub(crate) fn from_checked(alpha_x: f64, alpha_y: f64) -> Self {
+        Self::from_alphas(alpha_x, alpha_y)
     }
 
     fn from_alphas(ax: f64, ay: f64) -> Self {
@@ -45,8 +52,8 @@ impl Ggx {
     }
 
     pub fn isotropic(alpha: f64) -> ParamResult<Self> {
-        check_range("alpha", alpha, 0.0, 10.0, Bounds::OpenClosed)?;
-        Self::new(alpha, alpha)
+        check_alpha("alpha", alpha)?;
+        Ok(Self::from_alphas(alpha, alpha))
     }
 
     /// Isotropic GGX without validation, for internal proposals (width must be > 0).
@@ -130,10 +137,10 @@ impl Distribution for Ggx {
     /// [Dupuy & Benyoub 2023]'s spherical caps sample the same density with fewer operations
     /// (0.70× the time in the kernel bench). They are not used here because they map u to m
     /// differently, and the albedo tables integrate over u piecewise
-    /// (models/albedo_tables.rs), which is built for this map. Measured with the caps: 16- and
+    /// (models/multiple_scattering/albedo_tables.rs), which is built for this map. Measured with the caps: 16- and
     /// 48-point albedos differed by 9.9e-3 (the limit is 1.5e-3), and the compensated
     /// conductor failed its estimator χ² test. The caps are used below the horizon
-    /// (models/smith_microsurface.rs).
+    /// (models/multiple_scattering/smith_microsurface.rs).
     #[inline]
     fn sample_visible(&self, v: Vec3, u: Vec2) -> Vec3 {
         let vh = Vec3::new(self.ax * v.x, self.ay * v.y, v.z.max(0.0)).normalize();

@@ -13,7 +13,8 @@
 //! weighted. The printed Beckmann density lacks the 1/π of the normalized Beckmann D; we
 //! keep the normalized form (with 1/π the model's albedo stays below one).
 
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{check_alpha, check_range, Bounds};
+use crate::error::{ParamError, ParamResult};
 use crate::math::{Vec2, Vec3, PI, TWO_PI};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,10 +32,10 @@ impl HalfVectorDensity {
     pub fn new(name: &str, roughness: f64) -> ParamResult<Self> {
         match name {
             "ward" => Ok(HalfVectorDensity::Ward {
-                m: check_range("alpha", roughness, 0.0, 10.0, Bounds::OpenClosed)?,
+                m: check_alpha("alpha", roughness)?,
             }),
             "beckmann" => Ok(HalfVectorDensity::Beckmann {
-                m: check_range("alpha", roughness, 0.0, 10.0, Bounds::OpenClosed)?,
+                m: check_alpha("alpha", roughness)?,
             }),
             "phong" => Ok(HalfVectorDensity::Phong {
                 n: check_range("exponent", roughness, 0.0, 1e7, Bounds::Closed)?,

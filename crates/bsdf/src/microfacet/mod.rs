@@ -10,6 +10,7 @@ pub mod beckmann;
 pub mod gaussian;
 pub mod ggx;
 pub mod half_vector_density;
+pub mod integral;
 pub mod masking;
 pub mod phong;
 pub mod smith_lambda;

@@ -10,7 +10,8 @@
 use super::beckmann::Beckmann;
 use super::smith_lambda::LambdaTable;
 use super::Distribution;
-use crate::error::{check_range, Bounds, ParamResult};
+use crate::checks::{check_range, Bounds};
+use crate::error::ParamResult;
 use crate::math::{fmt_num, Vec2, Vec3, PI, TWO_PI};
 use std::sync::Arc;
 

@@ -30,9 +30,9 @@
 //! | `kd` | matte colour k (number or RGB) | [0, 1] | 0.5 |
 //! | `table_samples` | QMC samples per albedo-table entry | ≥ 64 | 16384 |
 
-use super::{flip, to_upper_pair};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
+use crate::checks::{check_min_count, check_reflectance};
+use crate::error::ParamResult;
 use crate::fresnel::Fresnel;
 use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::{Pcg32, RandomSource};
@@ -40,7 +40,7 @@ use crate::math::spectrum::Spectrum;
 use crate::math::warp::hammersley;
 use crate::math::{reflect, Vec3, PI, TWO_PI};
 use crate::microfacet::half_vector_density::HalfVectorDensity;
-use crate::spec::params::check_spectrum;
+use crate::two_sided::OpaqueBsdf;
 
 /// Number of intervals of the albedo table over [0, π/2].
 const TABLE_INTERVALS: usize = 90;
@@ -75,14 +75,8 @@ impl Kelemen {
         kd: Spectrum,
         table_samples: usize,
     ) -> ParamResult<Self> {
-        check_spectrum("kd", kd, 0.0, 1.0)?;
-        if table_samples < 64 {
-            return Err(ParamError::OutOfRange {
-                name: "table_samples".into(),
-                value: table_samples as f64,
-                expected: "table_samples >= 64".into(),
-            });
-        }
+        check_reflectance("kd", kd)?;
+        check_min_count("table_samples", table_samples, 64)?;
         let mut k = Kelemen {
             density,
             fresnel,
@@ -95,7 +89,7 @@ impl Kelemen {
 
     /// The same material with another matte colour k (the tables are shared).
     pub fn with_kd(&self, kd: Spectrum) -> ParamResult<Self> {
-        check_spectrum("kd", kd, 0.0, 1.0)?;
+        check_reflectance("kd", kd)?;
         Ok(Kelemen { kd, ..self.clone() })
     }
 
@@ -314,16 +308,13 @@ impl Kelemen {
     }
 }
 
-impl Bsdf for Kelemen {
+impl OpaqueBsdf for Kelemen {
     fn flags(&self) -> LobeFlags {
         LobeFlags::GLOSSY_REFLECTION | LobeFlags::DIFFUSE_REFLECTION
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => self.specular(o, i) + self.matte(o, i),
-            None => Spectrum::ZERO,
-        }
+        self.specular(wo, wi) + self.matte(wo, wi)
     }
 
     fn sample(
@@ -332,11 +323,7 @@ impl Bsdf for Kelemen {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
+        let o = wo;
         let ps = self.specular_choice(o);
         let (i, lobe) = if rng.next_f64() < ps {
             (
@@ -355,7 +342,7 @@ impl Bsdf for Kelemen {
         }
         let f = self.specular(o, i) + self.matte(o, i);
         Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
+            wi: i,
             weight: f * (i.z / pdf),
             pdf,
             lobe,
@@ -364,13 +351,8 @@ impl Bsdf for Kelemen {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => {
-                let ps = self.specular_choice(o);
-                ps * self.pdf_specular(o, i) + (1.0 - ps) * self.pdf_matte(i)
-            }
-            None => 0.0,
-        }
+        let ps = self.specular_choice(wo);
+        ps * self.pdf_specular(wo, wi) + (1.0 - ps) * self.pdf_matte(wi)
     }
 
     fn lobe_width(&self) -> f64 {
@@ -399,9 +381,4 @@ fn albedo_in(table: &[Spectrum], theta: f64) -> Spectrum {
     let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
     let t = x - k as f64;
     table[k] * (1.0 - t) + table[k + 1] * t
-}
-
-/// Validates a Kelemen Fresnel index.
-pub fn check_ior(ior: f64) -> ParamResult<f64> {
-    check_range("ior", ior, 1.0, 100.0, Bounds::OpenClosed)
 }

@@ -1,17 +1,19 @@
-//! The Lambertian BRDF f = R/π, sampled cosine-weighted. Two-sided.
+//! The Lambertian BRDF f = R/π, sampled cosine-weighted. Upper hemisphere
+//! ([`TwoSided`](crate::two_sided::TwoSided) makes it two-sided).
 //!
 //! | key | meaning | range | default |
 //! |---|---|---|---|
 //! | `reflectance` | albedo R (number or RGB) | [0, 1] | 0.5 |
 
-use super::cosine_lobe::{cosine_same_side_pdf, sample_cosine_same_side};
-use super::to_upper_pair;
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
+use crate::checks::check_reflectance;
 use crate::error::ParamResult;
+use crate::math::cosine_lobe::sample_cosine_same_side;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
+use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{Vec3, INV_PI};
-use crate::spec::params::check_spectrum;
+use crate::two_sided::OpaqueBsdf;
 
 #[derive(Clone, Debug)]
 pub struct Lambert {
@@ -21,21 +23,18 @@ pub struct Lambert {
 impl Lambert {
     pub fn new(reflectance: Spectrum) -> ParamResult<Self> {
         Ok(Lambert {
-            reflectance: check_spectrum("reflectance", reflectance, 0.0, 1.0)?,
+            reflectance: check_reflectance("reflectance", reflectance)?,
         })
     }
 }
 
-impl Bsdf for Lambert {
+impl OpaqueBsdf for Lambert {
     fn flags(&self) -> LobeFlags {
         LobeFlags::DIFFUSE_REFLECTION
     }
 
-    fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        match to_upper_pair(wo, wi) {
-            Some(_) => self.reflectance * INV_PI,
-            None => Spectrum::ZERO,
-        }
+    fn eval(&self, _: Vec3, _: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
+        self.reflectance * INV_PI
     }
 
     fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
@@ -50,8 +49,8 @@ impl Bsdf for Lambert {
         })
     }
 
-    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        cosine_same_side_pdf(wo, wi)
+    fn pdf(&self, _: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        cosine_hemisphere_pdf(wi)
     }
 
     fn describe(&self) -> String {

@@ -1,60 +1,36 @@
-//! The BSDF models, one file per model, each built from the shared parts of
-//! [`crate::microfacet`] (one specular lobe, one microfacet integrator). The
-//! multiple-scattering conductor and dielectric share the Smith-microsurface random walk of
-//! [`smith_microsurface`]; the compensated ones share the albedo tables of
-//! [`albedo_tables`].
+//! The BSDF models, one file per model, built from the shared parts below them
+//! ([`crate::microfacet`]: one specular lobe, one microfacet integrator; [`crate::fresnel`];
+//! [`crate::math`]). This file only declares and re-exports.
+//!
+//! - Single-lobe models stay at this level — [`lambert`], [`oren_nayar`],
+//!   [`rough_conductor`], [`rough_dielectric`], [`kelemen`]: each is complete in its file
+//!   and shares nothing private with another.
+//! - [`il`]: the interfaced-Lambertian family — the exact model, its V-cavity inter-
+//!   reflections, its tabulated and approximate body terms.
+//! - [`multiple_scattering`]: what single scattering loses, two ways — the random walk on
+//!   the Smith microsurface (HHdD16) and the Kulla–Conty compensation lobe with its albedo
+//!   tables (KC17).
+//! - [`glint`]: the CCM19 glint BRDF.
+//!
+//! Opaque models are written for the upper hemisphere; [`crate::two_sided::TwoSided`] makes
+//! them two-sided.
 
-pub mod albedo_tables;
-pub mod compensated_conductor;
-pub mod compensated_dielectric;
-pub(crate) mod cosine_lobe;
 pub mod glint;
-pub mod il_approx;
-pub mod il_approx_coefficients;
-pub mod il_table;
-pub mod il_table_part;
-pub mod interfaced_lambertian;
+pub mod il;
 pub mod kelemen;
 pub mod lambert;
-pub mod microfacet_integral;
-pub mod multiple_scattering_conductor;
-pub mod multiple_scattering_dielectric;
+pub mod multiple_scattering;
 pub mod oren_nayar;
 pub mod rough_conductor;
 pub mod rough_dielectric;
-pub mod smith_microsurface;
-pub mod vcavity;
 
-pub use compensated_conductor::CompensatedConductor;
-pub use compensated_dielectric::CompensatedDielectric;
-pub use interfaced_lambertian::InterfacedLambertian;
+pub use il::InterfacedLambertian;
 pub use kelemen::Kelemen;
 pub use lambert::Lambert;
-pub use multiple_scattering_conductor::MultipleScatteringConductor;
-pub use multiple_scattering_dielectric::MultipleScatteringDielectric;
+pub use multiple_scattering::{
+    CompensatedConductor, CompensatedDielectric, MultipleScatteringConductor,
+    MultipleScatteringDielectric,
+};
 pub use oren_nayar::{OrenNayarExact, OrenNayarQualitative};
 pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
-
-use crate::math::Vec3;
-
-/// Opaque BRDFs are two-sided: a query from below the surface is answered as its mirror
-/// image above it. Returns the pair flipped to the upper hemisphere, or `None` when the two
-/// directions are on opposite sides (or in the tangent plane).
-#[inline]
-pub(crate) fn to_upper_pair(wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
-    if wo.z * wi.z <= 0.0 {
-        return None;
-    }
-    if wo.z > 0.0 {
-        Some((wo, wi))
-    } else {
-        Some((flip(wo), flip(wi)))
-    }
-}
-
-/// Mirror image through the tangent plane.
-#[inline]
-pub(crate) fn flip(v: Vec3) -> Vec3 {
-    Vec3::new(v.x, v.y, -v.z)
-}

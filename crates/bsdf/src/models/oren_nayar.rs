@@ -18,16 +18,17 @@
 //! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (N microfacets, deterministic) | — | `quadrature` |
 //! | `samples` | exact, quadrature: microfacets per evaluation | ≥ 8 | 256 |
 
-use super::cosine_lobe::{cosine_same_side_pdf, sample_diffuse_reflection};
-use super::microfacet_integral::MicrofacetIntegral;
-use super::to_upper_pair;
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
+use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
+use crate::error::ParamResult;
+use crate::math::cosine_lobe::sample_cosine_same_side;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
+use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
+use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::{Gaussian, Masking, Ndf};
-use crate::spec::params::check_spectrum;
+use crate::two_sided::OpaqueBsdf;
 
 /// How a model estimates its microfacet integral.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,25 +52,16 @@ pub struct OrenNayarExact {
     evaluation: IntegralEvaluation,
 }
 
-/// Seed of the frozen quadrature point sets: fixed so that evaluation is deterministic.
-pub(crate) const QUADRATURE_SEED: u64 = 0x005e_ed0f_fac7;
-
 impl OrenNayarExact {
     pub fn new(
         reflectance: Spectrum,
         sigma: f64,
         evaluation: IntegralEvaluation,
     ) -> ParamResult<Self> {
-        check_spectrum("reflectance", reflectance, 0.0, 1.0)?;
+        check_reflectance("reflectance", reflectance)?;
         check_range("sigma", sigma, 0.0, 0.5 * PI, Bounds::Open)?;
         if let IntegralEvaluation::Quadrature { samples } = evaluation {
-            if samples < 8 {
-                return Err(ParamError::OutOfRange {
-                    name: "samples".into(),
-                    value: samples as f64,
-                    expected: "samples >= 8".into(),
-                });
-            }
+            check_min_count("samples", samples, 8)?;
         }
         Ok(OrenNayarExact {
             reflectance,
@@ -98,7 +90,7 @@ impl OrenNayarExact {
     }
 }
 
-impl Bsdf for OrenNayarExact {
+impl OpaqueBsdf for OrenNayarExact {
     fn flags(&self) -> LobeFlags {
         LobeFlags::DIFFUSE_REFLECTION
     }
@@ -108,10 +100,7 @@ impl Bsdf for OrenNayarExact {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => self.reflectance * (INV_PI * self.integral_value(i, o, rng).0),
-            None => Spectrum::ZERO,
-        }
+        self.reflectance * (INV_PI * self.integral_value(wi, wo, rng).0)
     }
 
     fn eval_estimate(
@@ -122,9 +111,7 @@ impl Bsdf for OrenNayarExact {
         samples: usize,
         rng: &mut dyn RandomSource,
     ) -> (Spectrum, Spectrum) {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return (Spectrum::ZERO, Spectrum::ZERO);
-        };
+        let (o, i) = (wo, wi);
         let (v, se) = match self.evaluation {
             IntegralEvaluation::Quadrature { .. } => self.integral_value(i, o, rng),
             IntegralEvaluation::Stochastic => {
@@ -150,8 +137,8 @@ impl Bsdf for OrenNayarExact {
         sample_diffuse_reflection(self, wo, ctx, rng)
     }
 
-    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        cosine_same_side_pdf(wo, wi)
+    fn pdf(&self, _: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        cosine_hemisphere_pdf(wi)
     }
 
     fn describe(&self) -> String {
@@ -165,6 +152,25 @@ impl Bsdf for OrenNayarExact {
             fmt_num(self.sigma)
         )
     }
+}
+
+/// A diffuse-reflection sample of `bsdf` drawn with the cosine lobe, weighted
+/// f·|cos θ_i|/pdf with f from `bsdf.eval` (which may be a stochastic estimate).
+fn sample_diffuse_reflection(
+    bsdf: &dyn OpaqueBsdf,
+    wo: Vec3,
+    ctx: &BsdfContext,
+    rng: &mut dyn RandomSource,
+) -> Option<BsdfSample> {
+    let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
+    let f = bsdf.eval(wo, wi, ctx, rng);
+    Some(BsdfSample {
+        wi,
+        weight: f * (wi.z.abs() / pdf),
+        pdf,
+        lobe: LobeFlags::DIFFUSE_REFLECTION,
+        eta: 1.0,
+    })
 }
 
 /// The scalar factor of Oren & Nayar's L1 model (single scattering, SIGGRAPH 1994, their
@@ -216,7 +222,7 @@ pub struct OrenNayarQualitative {
 
 impl OrenNayarQualitative {
     pub fn new(reflectance: Spectrum, sigma: f64) -> ParamResult<Self> {
-        check_spectrum("reflectance", reflectance, 0.0, 1.0)?;
+        check_reflectance("reflectance", reflectance)?;
         check_range("sigma", sigma, 0.0, 0.5 * PI, Bounds::ClosedOpen)?;
         let s2 = sigma * sigma;
         Ok(OrenNayarQualitative {
@@ -265,16 +271,13 @@ impl OrenNayarQualitative {
     }
 }
 
-impl Bsdf for OrenNayarQualitative {
+impl OpaqueBsdf for OrenNayarQualitative {
     fn flags(&self) -> LobeFlags {
         LobeFlags::DIFFUSE_REFLECTION
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        match to_upper_pair(wo, wi) {
-            Some((o, i)) => self.reflectance * (INV_PI * self.factor(i, o)),
-            None => Spectrum::ZERO,
-        }
+        self.reflectance * (INV_PI * self.factor(wi, wo))
     }
 
     fn sample(
@@ -286,8 +289,8 @@ impl Bsdf for OrenNayarQualitative {
         sample_diffuse_reflection(self, wo, ctx, rng)
     }
 
-    fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        cosine_same_side_pdf(wo, wi)
+    fn pdf(&self, _: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
+        cosine_hemisphere_pdf(wi)
     }
 
     fn describe(&self) -> String {

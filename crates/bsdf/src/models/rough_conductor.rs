@@ -1,7 +1,8 @@
 //! Rough conductor: the Cook–Torrance microfacet BRDF
 //! f = F(i, h) D(h) G(i, o, h) / (4 |i·n| |o·n|)  [WMLT07 eq. 20; IL18 eq. 4] with a conductor
 //! Fresnel term, any distribution and masking of the core; perfectly smooth (a delta
-//! reflection) when α = 0. Two-sided.
+//! reflection) when α = 0. Upper hemisphere ([`TwoSided`](crate::two_sided::TwoSided) makes
+//! it two-sided).
 //!
 //! | key | meaning | range | default |
 //! |---|---|---|---|
@@ -10,14 +11,14 @@
 //! | `eta`, `k` | complex index per channel (instead of `material`) | η > 0, k ≥ 0 | — |
 //! | `specular_reflectance` | multiplier of the lobe (number or RGB) | [0, 1] | 1 |
 
-use super::{flip, to_upper_pair};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::Vec3;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Distribution;
+use crate::two_sided::OpaqueBsdf;
 
 #[derive(Clone, Debug)]
 pub struct RoughConductor {
@@ -50,7 +51,7 @@ impl RoughConductor {
     }
 }
 
-impl Bsdf for RoughConductor {
+impl OpaqueBsdf for RoughConductor {
     fn flags(&self) -> LobeFlags {
         if self.lobe.is_some() {
             LobeFlags::GLOSSY_REFLECTION
@@ -60,18 +61,14 @@ impl Bsdf for RoughConductor {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, _: &mut dyn RandomSource) -> Spectrum {
-        let (Some(lobe), Some((o, i))) = (&self.lobe, to_upper_pair(wo, wi)) else {
+        let Some(lobe) = &self.lobe else {
             return Spectrum::ZERO;
         };
-        self.tint * lobe.eval(o, i, |c| self.fresnel.eval(c))
+        self.tint * lobe.eval(wo, wi, |c| self.fresnel.eval(c))
     }
 
     fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
+        let o = wo;
         let Some(lobe) = &self.lobe else {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
             return Some(BsdfSample {
@@ -86,7 +83,7 @@ impl Bsdf for RoughConductor {
         let (geom, _, cos_oh) = lobe.geometry(o, i)?;
         let weight = self.tint * self.fresnel.eval(cos_oh) * (geom * i.z / pdf);
         Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
+            wi: i,
             weight,
             pdf,
             lobe: LobeFlags::GLOSSY_REFLECTION,
@@ -96,9 +93,9 @@ impl Bsdf for RoughConductor {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        match (&self.lobe, to_upper_pair(wo, wi)) {
-            (Some(lobe), Some((o, i))) => lobe.pdf(o, i),
-            _ => 0.0,
+        match &self.lobe {
+            Some(lobe) => lobe.pdf(wo, wi),
+            None => 0.0,
         }
     }
 

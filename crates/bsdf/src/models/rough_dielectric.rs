@@ -88,7 +88,7 @@ impl RoughDielectric {
         reflect_tint: Spectrum,
         transmit_tint: Spectrum,
     ) -> ParamResult<Self> {
-        crate::error::check_range("eta", eta, 1e-3, 1e3, crate::error::Bounds::Closed)?;
+        crate::checks::check_range("eta", eta, 1e-3, 1e3, crate::checks::Bounds::Closed)?;
         if (eta - 1.0).abs() < 1e-4 {
             return Err(ParamError::Invalid(format!(
                 "ior / ext_ior = {eta}: the two indices must differ (by at least 1e-4) for the \

@@ -247,7 +247,7 @@ pub fn estimator_chi2_test(
 mod tests {
     use super::*;
     use crate::bsdf::{Bsdf, BsdfContext};
-    use crate::spec::{build_material, parse_inline_table};
+    use crate::recipe::{build_material, parse_inline_table};
 
     fn run(bsdf: &dyn Bsdf, scale: f64) -> EstimatorChi2Outcome {
         let wo = crate::math::spherical_direction(0.6, 0.3);

@@ -9,6 +9,8 @@ use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::{Beckmann, Masking, Ndf};
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::{OrenNayarExact, OrenNayarQualitative, RoughDielectric};
+// The Oren–Nayar comparison evaluates upper-hemisphere pairs only: the one-sided models suffice.
+use crate::two_sided::OpaqueBsdf;
 use rayon::prelude::*;
 
 /// Error of Oren & Nayar's qualitative model against the exact single-scattering integral

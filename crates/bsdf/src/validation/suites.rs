@@ -401,8 +401,8 @@ pub fn material_suite_matching(
         if !select(m) {
             continue;
         }
-        let table = crate::spec::parse_inline_table(m).expect("grid entries parse");
-        let bsdf = crate::spec::build_material(&table).expect("grid entries build");
+        let table = crate::recipe::parse_inline_table(m).expect("grid entries parse");
+        let bsdf = crate::recipe::build_material(&table).expect("grid entries build");
         r.extend(check_bsdf(bsdf.as_ref(), &bopts));
     }
     r

@@ -9,9 +9,10 @@ use crate::plot::{LineChart, Panels, Scale, Series};
 use facette_bsdf::math::quadrature::GaussLegendre;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Gaussian, Ggx, Masking, Ndf};
-use facette_bsdf::models::il_approx::IlApprox;
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::il_approx::IlApprox;
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::InterfacedLambertian;
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::validation::bsdf_checks::directional_albedo;
 use facette_bsdf::{Bsdf, BsdfContext, ParamError, Spectrum};
 use std::f64::consts::SQRT_2;
@@ -115,6 +116,7 @@ pub fn fig7(q: Quality) -> Result<Reproduction, ParamError> {
                     BodyEvaluation::Stochastic,
                     sc,
                 )
+                .map(TwoSided::new)
             };
             (
                 total_reflectance(&make(Scattering::Single)?, nodes, samples),
@@ -177,13 +179,13 @@ pub fn fig9(q: Quality) -> Result<Reproduction, ParamError> {
         .into_iter()
         .enumerate()
         {
-            let il = InterfacedLambertian::new(
+            let il = TwoSided::new(InterfacedLambertian::new(
                 Spectrum::splat(0.8),
                 1.5,
                 Some(beckmann_vcavity(sigma)?),
                 BodyEvaluation::Quadrature { samples: 4096 },
                 sc,
-            )?;
+            )?);
             let curve = plane_curve(&il, 30.0, Side::Reflection, Quantity::F, points, samples);
             c.series.push(Series::new(name, curve.clone(), k));
             curves.push(curve);

@@ -11,17 +11,26 @@ use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::half_vector_density::HalfVectorDensity;
 use facette_bsdf::models::Kelemen;
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::validation::bsdf_checks::directional_albedo;
 use facette_bsdf::{Bsdf, BsdfContext, ParamError, Spectrum};
 use std::sync::Arc;
 
-fn kelemen(density: &str, rough: f64, kd: f64, q: Quality) -> Result<Kelemen, ParamError> {
+/// The two-sided Kelemen BRDF (the figures query the upper hemisphere; `inner()` is the
+/// model with its tables).
+fn kelemen(
+    density: &str,
+    rough: f64,
+    kd: f64,
+    q: Quality,
+) -> Result<TwoSided<Kelemen>, ParamError> {
     Kelemen::new(
         HalfVectorDensity::new(density, rough)?,
         Fresnel::One,
         Spectrum::splat(kd),
         q.samples(16384, 1024),
     )
+    .map(TwoSided::new)
 }
 
 /// KSK01 Fig. 2: reflected radiance lobes f_s cos θ' of the specular term with the Ward
@@ -85,6 +94,7 @@ pub fn fig3(q: Quality) -> Result<Reproduction, ParamError> {
         .enumerate()
         {
             let model = kelemen(density, rough, 0.0, q)?;
+            let model = model.inner();
             let curve: Vec<(f64, f64)> = (0..=90)
                 .map(|d| (d as f64, model.albedo_at((d as f64).to_radians()).average()))
                 .collect();

@@ -12,7 +12,7 @@ use crate::plot::bsdf_data::{incidence_plane, signed_angles, Channel, Quantity, 
 use crate::plot::{LineChart, Panels};
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::models::InterfacedLambertian;
-use facette_bsdf::spec::{build_material, parse_inline_table};
+use facette_bsdf::recipe::{build_material, parse_inline_table};
 use facette_bsdf::{Bsdf, ParamError};
 use std::sync::Arc;
 

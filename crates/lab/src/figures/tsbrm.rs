@@ -12,9 +12,10 @@ use facette_bsdf::fresnel::fresnel_dielectric;
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Gaussian, Masking, Ndf};
-use facette_bsdf::models::interfaced_lambertian::{BodyEvaluation, Scattering};
+use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
 use facette_bsdf::models::oren_nayar::IntegralEvaluation;
 use facette_bsdf::models::{InterfacedLambertian, OrenNayarExact, OrenNayarQualitative};
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, ParamError, Spectrum, Vec3};
 
 /// A Gaussian/V-cavity lobe of width σ.
@@ -33,7 +34,7 @@ pub(crate) fn simonot(
     ni: f64,
     sigma: f64,
     samples: usize,
-) -> Result<InterfacedLambertian, ParamError> {
+) -> Result<TwoSided<InterfacedLambertian>, ParamError> {
     InterfacedLambertian::new(
         Spectrum::splat(kd),
         ni,
@@ -41,12 +42,13 @@ pub(crate) fn simonot(
         BodyEvaluation::Quadrature { samples },
         Scattering::Single,
     )
+    .map(TwoSided::new)
 }
 
 /// Oren–Nayar's qualitative model plus Cook–Torrance with the same Gaussian lobe and a
 /// dielectric Fresnel term of index n_i  [TSBRM eq. 42].
 pub(crate) struct OrenNayarCookTorrance {
-    pub on: OrenNayarQualitative,
+    pub on: TwoSided<OrenNayarQualitative>,
     pub lobe: SpecularLobe,
     pub ni: f64,
 }
@@ -76,7 +78,7 @@ impl OrenNayarCookTorrance {
 
 pub(crate) fn on_ct(kd: f64, ni: f64, sigma: f64) -> Result<OrenNayarCookTorrance, ParamError> {
     Ok(OrenNayarCookTorrance {
-        on: OrenNayarQualitative::new(Spectrum::splat(kd), sigma)?,
+        on: TwoSided::new(OrenNayarQualitative::new(Spectrum::splat(kd), sigma)?),
         lobe: gaussian_lobe(sigma)?,
         ni,
     })
@@ -96,7 +98,7 @@ pub fn fig14(q: Quality) -> Result<Reproduction, ParamError> {
     c.x_range = Some((-90.0, 90.0));
     let mut numbers = Vec::new();
     for (k, ni) in [1.0, 1.2, 1.33, 1.5].into_iter().enumerate() {
-        let curve = body_curve(&simonot(0.9, ni, 0.5, n)?, 60.0, points);
+        let curve = body_curve(simonot(0.9, ni, 0.5, n)?.inner(), 60.0, points);
         numbers.push(format!(
             "n_i = {ni}: f_v(θ_o = −60°, backscatter) = {:.4}, f_v(0°) = {:.4}, f_v(+60°) = {:.4}, f_v(+85°) = {:.4}",
             at(&curve, -60.0),
@@ -105,11 +107,11 @@ pub fn fig14(q: Quality) -> Result<Reproduction, ParamError> {
             at(&curve, 85.0)
         ));
         if ni == 1.0 {
-            let on = OrenNayarExact::new(
+            let on = TwoSided::new(OrenNayarExact::new(
                 Spectrum::splat(0.9),
                 0.5,
                 IntegralEvaluation::Quadrature { samples: n },
-            )?;
+            )?);
             let exact = plane_curve(&on, 60.0, Side::Reflection, Quantity::F, points, 1);
             let worst = curve
                 .iter()

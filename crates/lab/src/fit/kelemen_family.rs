@@ -9,6 +9,7 @@ use facette_bsdf::fresnel::Fresnel;
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::microfacet::half_vector_density::HalfVectorDensity;
 use facette_bsdf::models::Kelemen;
+use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, ParamError, Spectrum};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
@@ -73,9 +74,11 @@ impl ModelFamily for KelemenFamily {
     }
 
     fn predict(&self, p: &[f64], samples: &[FitSample]) -> Result<Vec<Spectrum>, ParamError> {
-        let k = self
-            .model(p[3], p[4])?
-            .with_kd(Spectrum::rgb(p[0], p[1], p[2]))?;
+        // Measured samples may lie on either side: the two-sided BRDF, as a material.
+        let k = TwoSided::new(
+            self.model(p[3], p[4])?
+                .with_kd(Spectrum::rgb(p[0], p[1], p[2]))?,
+        );
         Ok(samples
             .par_iter()
             .map(|s| k.eval(s.o, s.i, &BsdfContext::RADIANCE, &mut Pcg32::new(1, 1)))

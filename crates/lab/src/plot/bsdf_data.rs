@@ -195,10 +195,11 @@ impl Channel {
 mod tests {
     use super::*;
     use facette_bsdf::models::Lambert;
+    use facette_bsdf::two_sided::TwoSided;
 
     #[test]
     fn lambert_slice_is_flat_and_polar_is_a_circle() {
-        let l = Lambert::new(Spectrum::splat(0.5)).unwrap();
+        let l = TwoSided::new(Lambert::new(Spectrum::splat(0.5)).unwrap());
         let angles = signed_angles(7);
         let s = incidence_plane(&l, 30.0, Side::Reflection, Quantity::F, &angles, 1, 1);
         for (_, v) in &s {

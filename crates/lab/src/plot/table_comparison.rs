@@ -6,7 +6,7 @@
 use super::bsdf_data::{light_direction, plane_direction, signed_angles, Side};
 use super::line_chart::{LineChart, Series};
 use facette_bsdf::math::rng::Pcg32;
-use facette_bsdf::models::il_table::BodyTable;
+use facette_bsdf::models::il::il_table::BodyTable;
 use facette_bsdf::models::InterfacedLambertian;
 use facette_bsdf::Vec3;
 use rayon::prelude::*;
@@ -94,7 +94,9 @@ pub fn compare_table(
     };
     chart.series.push(Series::new(
         match quadrature.evaluation() {
-            facette_bsdf::models::interfaced_lambertian::BodyEvaluation::Quadrature { samples } => {
+            facette_bsdf::models::il::interfaced_lambertian::BodyEvaluation::Quadrature {
+                samples,
+            } => {
                 format!("quadrature ({samples} microfacets)")
             }
             _ => "reference".to_string(),

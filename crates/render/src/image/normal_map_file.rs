@@ -1,6 +1,6 @@
 //! Normal map files for the glint material  [CCM19 §3]: reading (PNG 8/16-bit, OpenEXR,
 //! Radiance HDR, decoded without any colour transform) for
-//! [`facette_bsdf::spec::NormalMapReader`], and writing (16-bit PNG with the unsigned
+//! [`facette_bsdf::recipe::NormalMapReader`], and writing (16-bit PNG with the unsigned
 //! encoding n = 2c − 1, or float EXR with the signed encoding n = c), atomically.
 //!
 //! Validation of the pixels (grey images, non-unit or downward normals) is done by
@@ -11,7 +11,7 @@ use super::exr_file::write_exr_rgb;
 use super::io::{read_image, ColorEncoding};
 use super::rgb_image::RgbImage;
 use facette_bsdf::models::glint::{NormalEncoding, NormalMap};
-use facette_bsdf::spec::{DecodedImage, NormalMapReader};
+use facette_bsdf::recipe::{DecodedImage, NormalMapReader};
 use facette_bsdf::storage::atomic_file::{write_atomically_with, Existing};
 use std::fs::File;
 use std::io::BufWriter;

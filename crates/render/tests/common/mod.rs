@@ -6,7 +6,7 @@
 #![allow(dead_code)]
 
 use facette_bsdf::math::rng::Pcg32;
-use facette_bsdf::spec::build_material_in;
+use facette_bsdf::recipe::build_material_in;
 use facette_bsdf::BsdfContext;
 use facette_render::geometry::{Vec2, Vec3};
 use facette_render::scene::{load_scene_with, LoadOptions, Scene};

@@ -4,8 +4,9 @@
 //!             = F(o·h) χ⁺(o·h) χ⁺(i·h) D_P(h) / (4 I_P(o) I_P(i)),
 //!
 //! the second form after the projected areas cancel (see [`super::patch_masking`]), with a
-//! conductor (or F = 1) Fresnel term and a reflectance multiplier. Two-sided like every
-//! opaque model of the library. Reciprocal (symmetric in o and i).
+//! conductor (or F = 1) Fresnel term and a reflectance multiplier. Written for the upper
+//! hemisphere like every opaque model of the library ([`crate::two_sided::TwoSided`] makes it
+//! two-sided). Reciprocal (symmetric in o and i).
 //!
 //! **Sampling**: a lobe of the footprint, then a slope of that lobe ([`PatchNdf`]), mirrored:
 //! pdf(i) = D_P(h) cos θ_h / (4 o·h)  [WMLT07 eqs. 14, 38; CCM19 §5], the density the
@@ -21,11 +22,12 @@ use super::patch_masking::{MaskingMode, PatchMasking};
 use super::patch_ndf::PatchNdf;
 use super::patch_reflection::{self, PatchReflection};
 use super::surface::GlintSurface;
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{fmt_num, Vec3};
+use crate::two_sided::OpaqueBsdf;
 use std::sync::{Arc, Mutex};
 
 /// Material parameters besides the surface and the footprint.
@@ -125,7 +127,7 @@ impl PatchReflection for GlintBsdf {
     }
 }
 
-impl Bsdf for GlintBsdf {
+impl OpaqueBsdf for GlintBsdf {
     fn flags(&self) -> LobeFlags {
         LobeFlags::GLOSSY_REFLECTION
     }

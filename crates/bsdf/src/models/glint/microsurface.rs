@@ -24,7 +24,8 @@
 
 use super::lobe::SlopeLobe;
 use super::normal_map::NormalMap;
-use crate::error::{check_range, Bounds, ParamResult};
+use crate::checks::{check_range, Bounds};
+use crate::error::ParamResult;
 use crate::math::quadrature::GaussLegendre;
 use rayon::prelude::*;
 use std::sync::OnceLock;

@@ -12,7 +12,6 @@ use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{reflect, Vec3};
-use crate::models::{flip, to_upper_pair};
 
 /// What distinguishes one patch model from another.
 pub(crate) trait PatchReflection {
@@ -50,11 +49,8 @@ pub(crate) fn eval_with_d(
     p.tint() * p.fresnel().eval(cos_oh) * v
 }
 
-/// f(wo, wi), both sides of the surface.
-pub(crate) fn eval(p: &impl PatchReflection, wo: Vec3, wi: Vec3) -> Spectrum {
-    let Some((o, i)) = to_upper_pair(wo, wi) else {
-        return Spectrum::ZERO;
-    };
+/// f(o, i) for an upper-hemisphere pair.
+pub(crate) fn eval(p: &impl PatchReflection, o: Vec3, i: Vec3) -> Spectrum {
     let h = (o + i).normalize_or_zero();
     let cos_oh = o.dot(h);
     if !(h.z > 0.0) || !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
@@ -70,11 +66,10 @@ pub(crate) fn sample(
     wo: Vec3,
     rng: &mut dyn RandomSource,
 ) -> Option<BsdfSample> {
-    if wo.z == 0.0 || !wo.is_finite() {
+    if !wo.is_finite() {
         return None;
     }
-    let below = wo.z < 0.0;
-    let o = if below { flip(wo) } else { wo };
+    let o = wo;
     let m = p.sample_normal(rng)?;
     if !(o.dot(m) > 0.0) {
         return None;
@@ -98,7 +93,7 @@ pub(crate) fn sample(
         return None;
     }
     Some(BsdfSample {
-        wi: if below { flip(i) } else { i },
+        wi: i,
         weight,
         pdf,
         lobe: LobeFlags::GLOSSY_REFLECTION,
@@ -106,11 +101,8 @@ pub(crate) fn sample(
     })
 }
 
-/// The density of [`sample`].
-pub(crate) fn pdf(p: &impl PatchReflection, wo: Vec3, wi: Vec3) -> f64 {
-    let Some((o, i)) = to_upper_pair(wo, wi) else {
-        return 0.0;
-    };
+/// The density of [`sample`] for an upper-hemisphere pair.
+pub(crate) fn pdf(p: &impl PatchReflection, o: Vec3, i: Vec3) -> f64 {
     let h = (o + i).normalize_or_zero();
     let cos_oh = o.dot(h);
     if !(h.z > 0.0) || !(cos_oh > 0.0) {

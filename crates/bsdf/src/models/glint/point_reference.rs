@@ -19,11 +19,12 @@
 use super::lobe::{normal_of_slope, LobeF64, SlopeLobe};
 use super::normal_map::NormalMap;
 use super::patch_reflection::{self, PatchReflection};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{Vec2, Vec3};
+use crate::two_sided::OpaqueBsdf;
 
 /// One point of a normal-mapped near-specular conductor.
 pub struct PointReferenceBsdf {
@@ -94,7 +95,7 @@ impl PatchReflection for PointReferenceBsdf {
     }
 }
 
-impl Bsdf for PointReferenceBsdf {
+impl OpaqueBsdf for PointReferenceBsdf {
     fn flags(&self) -> LobeFlags {
         LobeFlags::GLOSSY_REFLECTION
     }
@@ -132,6 +133,7 @@ impl Bsdf for PointReferenceBsdf {
 mod tests {
     use super::*;
     use crate::models::glint::generate::{generate, NormalMapKind};
+    use crate::two_sided::TwoSided;
     use crate::validation::bsdf_checks::{check_bsdf, BsdfCheckOptions};
     use crate::validation::Report;
 
@@ -145,15 +147,26 @@ mod tests {
         let flat = NormalMap::from_slopes(4, 4, vec![[0.0, 0.0]; 16]).unwrap();
         let mut r = Report::new();
         for (texel, floor) in [(Vec2::new(7.3, 11.8), 0.05), (Vec2::new(20.1, 3.6), 0.2)] {
-            let b = PointReferenceBsdf::new(&map, texel, floor, Fresnel::One, Spectrum::ONE);
+            let b = TwoSided::new(PointReferenceBsdf::new(
+                &map,
+                texel,
+                floor,
+                Fresnel::One,
+                Spectrum::ONE,
+            ));
             r.extend(
                 check_bsdf(&b, &BsdfCheckOptions::default())
                     .into_iter()
                     .filter(|c| !c.name.starts_with("directional albedo")),
             );
         }
-        let b =
-            PointReferenceBsdf::new(&flat, Vec2::new(1.5, 2.5), 0.1, Fresnel::One, Spectrum::ONE);
+        let b = TwoSided::new(PointReferenceBsdf::new(
+            &flat,
+            Vec2::new(1.5, 2.5),
+            0.1,
+            Fresnel::One,
+            Spectrum::ONE,
+        ));
         r.extend(check_bsdf(&b, &BsdfCheckOptions::default()));
         assert!(r
             .checks

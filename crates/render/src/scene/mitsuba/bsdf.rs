@@ -22,7 +22,7 @@ use super::texture::{color_value, constant_color, rgb_value, texture_table};
 use super::translator::Translator;
 use crate::scene::SceneError;
 use facette_bsdf::fresnel::internal_diffuse_reflectance;
-use facette_bsdf::spec::MATERIAL_TYPES;
+use facette_bsdf::recipe::MATERIAL_TYPES;
 use std::rc::Rc;
 
 /// The Mitsuba BSDF plugins facette reads.

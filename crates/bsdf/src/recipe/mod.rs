@@ -1,13 +1,18 @@
 //! Materials and distributions written as TOML tables — the syntax shared by the command
 //! line (`--material '{type = "dielectric", alpha = 0.3}'`) and the scene files. Every key
 //! is validated; unknown keys and values are errors that list the valid ones.
+//!
+//! - [`params`]: typed access to a table that reports unknown keys;
+//! - [`microfacet`]: the microfacet keys shared by every rough model;
+//! - [`material`]: [`MaterialRecipe`], one file per family of models.
+//!
+//! This is the top layer of the crate's models: it imports models, never the reverse.
 
-pub mod glint;
 pub mod material;
 pub mod microfacet;
 pub mod params;
 
-pub use glint::{DecodedImage, GlintRecipe, NormalMapReader};
+pub use material::glint::{DecodedImage, GlintRecipe, NormalMapReader};
 pub use material::{
     build_material, build_material_in, build_material_with_reader, MaterialRecipe, MATERIAL_TYPES,
 };

@@ -20,15 +20,15 @@
 //! is the exact mixture and the weight eval·cos/pdf.
 
 use super::albedo_tables::{table_alpha, AlbedoTable, TableFresnel};
-use super::rough_conductor::RoughConductor;
-use super::{flip, to_upper_pair};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
 use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{Vec3, INV_PI, TWO_PI};
 use crate::microfacet::specular_lobe::SpecularLobe;
+use crate::models::rough_conductor::RoughConductor;
+use crate::two_sided::OpaqueBsdf;
 use std::sync::Arc;
 
 #[derive(Clone, Debug)]
@@ -107,16 +107,13 @@ impl CompensatedConductor {
     }
 }
 
-impl Bsdf for CompensatedConductor {
+impl OpaqueBsdf for CompensatedConductor {
     fn flags(&self) -> LobeFlags {
         LobeFlags::GLOSSY_REFLECTION | LobeFlags::DIFFUSE_REFLECTION
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return Spectrum::ZERO;
-        };
-        self.single.eval(wo, wi, ctx, rng) + self.compensation(o, i)
+        self.single.eval(wo, wi, ctx, rng) + self.compensation(wo, wi)
     }
 
     fn sample(
@@ -125,11 +122,7 @@ impl Bsdf for CompensatedConductor {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
+        let o = wo;
         let (i, lobe) = if rng.next_f64() < self.single_share(o) {
             (
                 self.lobe().sample(o, rng.next_2d())?.0,
@@ -144,7 +137,7 @@ impl Bsdf for CompensatedConductor {
         if i.z <= 0.0 {
             return None;
         }
-        let wi = if below { flip(i) } else { i };
+        let wi = i;
         let pdf = self.pdf(wo, wi, ctx);
         if !(pdf > 0.0) {
             return None;
@@ -160,9 +153,7 @@ impl Bsdf for CompensatedConductor {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return 0.0;
-        };
+        let (o, i) = (wo, wi);
         let ps = self.single_share(o);
         let p = ps * self.lobe().pdf(o, i) + (1.0 - ps) * self.table.lobe_density(i.z, self.alpha);
         if p.is_finite() {

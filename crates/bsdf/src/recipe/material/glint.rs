@@ -34,9 +34,9 @@
 //! s = [`PIXEL_FOOTPRINT_SIGMA`]. Without derivatives (secondary hits, `facette eval`) it
 //! uses `footprint_size` around the given uv (or `footprint_center`).
 
-use super::params::{check_spectrum, Params};
 use crate::bsdf::Bsdf;
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::checks::{check_range, check_reflectance, Bounds};
+use crate::error::{ParamError, ParamResult};
 use crate::math::spectrum::Spectrum;
 use crate::math::Vec2;
 use crate::models::glint::generate::{generate, NormalMapKind};
@@ -45,6 +45,8 @@ use crate::models::glint::patch_masking::{MaskingMode, DEFAULT_MASKING_LOBES};
 use crate::models::glint::{
     Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap, PointReferenceBsdf,
 };
+use crate::recipe::params::Params;
+use crate::two_sided::TwoSided;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -136,18 +138,19 @@ impl GlintRecipe {
     pub fn build_at(&self, uv: Vec2, derivs: [f64; 4]) -> Arc<dyn Bsdf> {
         if self.reference {
             let center = self.footprint_at(uv, [0.0; 4]).center;
-            return Arc::new(PointReferenceBsdf::new(
+            return Arc::new(TwoSided::new(PointReferenceBsdf::new(
                 self.surface.map(),
                 center,
                 self.surface.roughness_floor(),
                 self.params.fresnel,
                 self.params.tint,
-            ));
+            )));
         }
-        Arc::new(self.bsdf_at(uv, derivs))
+        Arc::new(TwoSided::new(self.bsdf_at(uv, derivs)))
     }
 
-    /// The concrete BSDF of a shading point.
+    /// The concrete model of a shading point, for the upper hemisphere (what
+    /// [`build_at`](Self::build_at) wraps in [`TwoSided`]).
     pub fn bsdf_at(&self, uv: Vec2, derivs: [f64; 4]) -> GlintBsdf {
         GlintBsdf::new(
             self.surface.clone(),
@@ -178,6 +181,53 @@ pub fn parse_glint(
 ) -> ParamResult<GlintRecipe> {
     let floor = p.f64_or("roughness_floor", DEFAULT_ROUGHNESS_FLOOR)?;
     crate::models::glint::microsurface::check_roughness_floor(floor)?;
+    let (map, label) = parse_map(p, base_dir, reader)?;
+    let uv_scale = pair(p, "uv_scale", [1.0, 1.0])?;
+    for (k, v) in ["uv_scale (u)", "uv_scale (v)"].iter().zip(uv_scale) {
+        check_range(k, v, 0.0, 1e6, Bounds::OpenClosed)?;
+    }
+    let (footprint_center, footprint_size) = parse_footprint(p)?;
+    let masking = MaskingMode::parse(p.str("masking")?.unwrap_or("exact"))?;
+    let masking_lobes = p.usize("masking_lobes")?.unwrap_or(DEFAULT_MASKING_LOBES);
+    let reference = match p.str("evaluation")?.unwrap_or("patch") {
+        "patch" => false,
+        "reference" => true,
+        other => {
+            return Err(ParamError::UnknownChoice {
+                what: "glint evaluation".into(),
+                given: other.into(),
+                valid: "patch, reference".into(),
+            })
+        }
+    };
+    let fresnel = super::microfacet_models::parse_conductor_fresnel(p)?;
+    let tint = check_reflectance(
+        "specular_reflectance",
+        p.spectrum("specular_reflectance")?.unwrap_or(Spectrum::ONE),
+    )?;
+    let surface = Arc::new(GlintSurface::build(map, floor, label)?);
+    Ok(GlintRecipe {
+        surface,
+        params: GlintParams {
+            fresnel,
+            tint,
+            masking,
+            masking_lobes,
+        },
+        uv_scale,
+        footprint_center,
+        footprint_size,
+        reference,
+    })
+}
+
+/// The normal map and its label: a file (`normal_map`, read with `reader`) or a procedural
+/// map (`generate`, `resolution`, `seed`).
+fn parse_map(
+    p: &Params,
+    base_dir: &Path,
+    reader: Option<&dyn NormalMapReader>,
+) -> ParamResult<(NormalMap, String)> {
     let file = p.str("normal_map")?;
     let kind = p.str("generate")?;
     let resolution = p.usize("resolution")?;
@@ -186,22 +236,17 @@ pub fn parse_glint(
         .str("normal_encoding")?
         .map(NormalEncoding::parse)
         .transpose()?;
-    let (map, label) = match (file, kind) {
-        (Some(_), Some(_)) => {
-            return Err(ParamError::Invalid(
-                "give either `normal_map` (a file) or `generate` (a procedural map), not both"
-                    .into(),
-            ))
-        }
-        (None, None) => {
-            return Err(ParamError::MissingKey {
-                key: format!(
-                    "normal_map (a file) or generate (one of: {})",
-                    NormalMapKind::NAMES.join(", ")
-                ),
-                context: p.context().into(),
-            })
-        }
+    match (file, kind) {
+        (Some(_), Some(_)) => Err(ParamError::Invalid(
+            "give either `normal_map` (a file) or `generate` (a procedural map), not both".into(),
+        )),
+        (None, None) => Err(ParamError::MissingKey {
+            key: format!(
+                "normal_map (a file) or generate (one of: {})",
+                NormalMapKind::NAMES.join(", ")
+            ),
+            context: p.context().into(),
+        }),
         (Some(path), None) => {
             if resolution.is_some() || seed.is_some() {
                 return Err(ParamError::Invalid(
@@ -209,31 +254,7 @@ pub fn parse_glint(
                         .into(),
                 ));
             }
-            let reader = reader.ok_or_else(|| {
-                ParamError::Invalid(format!(
-                    "normal_map \"{path}\": this entry point cannot read image files (facette-bsdf \
-                     does not decode images); use the facette CLI or renderer, or `generate`"
-                ))
-            })?;
-            let full = base_dir.join(path);
-            let img = reader.read(&full).map_err(ParamError::Invalid)?;
-            let enc = encoding.unwrap_or(if img.float {
-                NormalEncoding::Signed
-            } else {
-                NormalEncoding::Unsigned
-            });
-            let map = NormalMap::from_pixels(
-                img.width,
-                img.height,
-                &img.pixels,
-                enc,
-                &full.display().to_string(),
-            )?;
-            let name = Path::new(path)
-                .file_name()
-                .map(|n| n.to_string_lossy().to_string())
-                .unwrap_or_else(|| path.to_string());
-            (map, name)
+            read_map_file(path, base_dir, reader, encoding)
         }
         (None, Some(k)) => {
             if encoding.is_some() {
@@ -245,13 +266,47 @@ pub fn parse_glint(
             let res = resolution.unwrap_or(512);
             let seed = seed.unwrap_or(1) as u64;
             let map = generate(kind, res, seed)?;
-            (map, format!("{} {res}² seed {seed}", kind.name()))
+            Ok((map, format!("{} {res}² seed {seed}", kind.name())))
         }
-    };
-    let uv_scale = pair(p, "uv_scale", [1.0, 1.0])?;
-    for (k, v) in ["uv_scale (u)", "uv_scale (v)"].iter().zip(uv_scale) {
-        check_range(k, v, 0.0, 1e6, Bounds::OpenClosed)?;
     }
+}
+
+/// A normal map file, decoded by `reader`; its label is the file name.
+fn read_map_file(
+    path: &str,
+    base_dir: &Path,
+    reader: Option<&dyn NormalMapReader>,
+    encoding: Option<NormalEncoding>,
+) -> ParamResult<(NormalMap, String)> {
+    let reader = reader.ok_or_else(|| {
+        ParamError::Invalid(format!(
+            "normal_map \"{path}\": this entry point cannot read image files (facette-bsdf \
+             does not decode images); use the facette CLI or renderer, or `generate`"
+        ))
+    })?;
+    let full = base_dir.join(path);
+    let img = reader.read(&full).map_err(ParamError::Invalid)?;
+    let enc = encoding.unwrap_or(if img.float {
+        NormalEncoding::Signed
+    } else {
+        NormalEncoding::Unsigned
+    });
+    let map = NormalMap::from_pixels(
+        img.width,
+        img.height,
+        &img.pixels,
+        enc,
+        &full.display().to_string(),
+    )?;
+    let name = Path::new(path)
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| path.to_string());
+    Ok((map, name))
+}
+
+/// `footprint_center` (uv) and `footprint_size` (σ_u, σ_v, ρ in texels).
+fn parse_footprint(p: &Params) -> ParamResult<([f64; 2], [f64; 3])> {
     let footprint_center = pair(p, "footprint_center", [0.5, 0.5])?;
     for v in footprint_center {
         if !v.is_finite() {
@@ -294,38 +349,5 @@ pub fn parse_glint(
         1.0,
         Bounds::Open,
     )?;
-    let masking = MaskingMode::parse(p.str("masking")?.unwrap_or("exact"))?;
-    let masking_lobes = p.usize("masking_lobes")?.unwrap_or(DEFAULT_MASKING_LOBES);
-    let reference = match p.str("evaluation")?.unwrap_or("patch") {
-        "patch" => false,
-        "reference" => true,
-        other => {
-            return Err(ParamError::UnknownChoice {
-                what: "glint evaluation".into(),
-                given: other.into(),
-                valid: "patch, reference".into(),
-            })
-        }
-    };
-    let fresnel = super::material::parse_conductor_fresnel(p)?;
-    let tint = check_spectrum(
-        "specular_reflectance",
-        p.spectrum("specular_reflectance")?.unwrap_or(Spectrum::ONE),
-        0.0,
-        1.0,
-    )?;
-    let surface = Arc::new(GlintSurface::build(map, floor, label)?);
-    Ok(GlintRecipe {
-        surface,
-        params: GlintParams {
-            fresnel,
-            tint,
-            masking,
-            masking_lobes,
-        },
-        uv_scale,
-        footprint_center,
-        footprint_size,
-        reference,
-    })
+    Ok((footprint_center, footprint_size))
 }

@@ -11,8 +11,9 @@
 //! | `masking` | `smith`, `smith-correlated`, `v-cavity`, `kelemen` | `smith` (`v-cavity` for gaussian) |
 //! | `sampling` | `visible`, `distribution` | `visible` |
 
-use super::params::Params;
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use super::params::{choice, Params};
+use crate::checks::check_alpha_or_smooth;
+use crate::error::{ParamError, ParamResult};
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::{
     Beckmann, BeckmannG1, Gaussian, Ggx, Masking, Ndf, Phong, PhongG1, SMOOTH_ALPHA,
@@ -54,8 +55,10 @@ pub fn parse_distribution(p: &Params, allow_smooth: bool) -> ParamResult<Option<
                     ))
                 }
             };
-            check_range("alpha", ax, 0.0, 10.0, Bounds::Closed)?;
-            check_range("alpha", ay, 0.0, 10.0, Bounds::Closed)?;
+            // The one range check of a table's widths: the constructors below take them as
+            // checked.
+            check_alpha_or_smooth("alpha", ax)?;
+            check_alpha_or_smooth("alpha", ay)?;
             if ax < SMOOTH_ALPHA && ay < SMOOTH_ALPHA {
                 if g1.is_some() {
                     return Err(ParamError::Invalid(
@@ -71,14 +74,14 @@ pub fn parse_distribution(p: &Params, allow_smooth: bool) -> ParamResult<Option<
                     "rational" => BeckmannG1::Rational,
                     other => return Err(choice("g1", other, &["exact", "rational"])),
                 };
-                Ndf::Beckmann(Beckmann::new(ax, ay)?.with_g1(form))
+                Ndf::Beckmann(Beckmann::from_checked(ax, ay).with_g1(form))
             } else {
                 if let Some(other) = g1 {
                     if other != "exact" {
                         return Err(choice("g1", other, &["exact"]));
                     }
                 }
-                Ndf::Ggx(Ggx::new(ax, ay)?)
+                Ndf::Ggx(Ggx::from_checked(ax, ay))
             }
         }
         "gaussian" => {
@@ -136,14 +139,6 @@ fn smooth(allow: bool, alpha: f64) -> ParamResult<Option<Ndf>> {
     }
 }
 
-fn choice(what: &str, given: &str, valid: &[&str]) -> ParamError {
-    ParamError::UnknownChoice {
-        what: what.into(),
-        given: given.into(),
-        valid: valid.join(", "),
-    }
-}
-
 /// Reads `masking` (default: `smith`, or `v-cavity` for the Gaussian).
 pub fn parse_masking(p: &Params, ndf: Option<&Ndf>) -> ParamResult<Masking> {
     match p.str("masking")? {
@@ -163,6 +158,43 @@ pub fn parse_sampling(p: &Params) -> ParamResult<NormalSampling> {
     }
 }
 
+/// The distribution with one roughness parameter replaced (small widths are clamped to the
+/// smallest rough width, 1e-4). Each value is range-checked once: a width α here (the
+/// constructors then take it as checked), σ and the Phong exponent by their constructors.
+pub fn with_roughness(ndf: &Ndf, key: &str, v: f64) -> ParamResult<Ndf> {
+    let width = || check_alpha_or_smooth(key, v).map(|a| a.max(SMOOTH_ALPHA));
+    Ok(match (ndf, key) {
+        (Ndf::Beckmann(b), "alpha") => {
+            let w = width()?;
+            Ndf::Beckmann(Beckmann::from_checked(w, w).with_g1(b.g1_form()))
+        }
+        (Ndf::Beckmann(b), "alpha_u") => {
+            Ndf::Beckmann(Beckmann::from_checked(width()?, b.alpha_y()).with_g1(b.g1_form()))
+        }
+        (Ndf::Beckmann(b), "alpha_v") => {
+            Ndf::Beckmann(Beckmann::from_checked(b.alpha_x(), width()?).with_g1(b.g1_form()))
+        }
+        (Ndf::Ggx(_), "alpha") => {
+            let w = width()?;
+            Ndf::Ggx(Ggx::from_checked(w, w))
+        }
+        (Ndf::Ggx(g), "alpha_u") => Ndf::Ggx(Ggx::from_checked(width()?, g.alpha_y())),
+        (Ndf::Ggx(g), "alpha_v") => Ndf::Ggx(Ggx::from_checked(g.alpha_x(), width()?)),
+        // σ = 0 is the smooth limit, clamped like α; a negative σ must not be clamped.
+        (Ndf::Gaussian(_), "sigma") if v >= 0.0 => {
+            Ndf::Gaussian(Gaussian::new(v.max(SMOOTH_ALPHA))?)
+        }
+        (Ndf::Gaussian(_), "sigma") => Ndf::Gaussian(Gaussian::new(v)?),
+        (Ndf::Phong(_), "exponent") => Ndf::Phong(Phong::new(v)?),
+        _ => {
+            return Err(ParamError::Invalid(format!(
+                "`{key}` is not a roughness parameter of {}",
+                crate::microfacet::Distribution::describe(ndf)
+            )))
+        }
+    })
+}
+
 /// Distribution, masking and sampling together; `Ok(None)` for a smooth surface.
 pub fn parse_specular_lobe(p: &Params, allow_smooth: bool) -> ParamResult<Option<SpecularLobe>> {
     let ndf = parse_distribution(p, allow_smooth)?;
@@ -178,7 +210,7 @@ pub fn parse_specular_lobe(p: &Params, allow_smooth: bool) -> ParamResult<Option
 mod tests {
     use super::*;
     use crate::microfacet::Distribution;
-    use crate::spec::parse_inline_table;
+    use crate::recipe::parse_inline_table;
 
     fn lobe(s: &str) -> ParamResult<Option<SpecularLobe>> {
         let t = parse_inline_table(s).unwrap();

@@ -29,8 +29,7 @@
 //!   0.1 % of |cos θ|/2π over the sphere.
 
 use super::compensated_dielectric::CompensatedDielectric;
-use super::multiple_scattering_conductor::{check_lobe, PROXY_COSINE_SHARE};
-use super::rough_dielectric::RoughDielectric;
+use super::random_walk::{check_lobe, PROXY_COSINE_SHARE};
 use super::smith_microsurface::{FacetScattering, HeightDistribution, Microsurface};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
@@ -38,6 +37,7 @@ use crate::fresnel::fresnel_dielectric;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{reflect, refract, Vec3, TWO_PI};
+use crate::models::rough_dielectric::RoughDielectric;
 
 /// Dielectric facets between the outside (index 1) and the inside (index η).
 #[derive(Clone, Debug)]

@@ -27,13 +27,13 @@
 //! exact density on that side. The pdf is the exact mixture, the weight eval·|cos|/pdf.
 
 use super::albedo_tables::{table_alpha, AlbedoTable, TableFresnel};
-use super::rough_dielectric::RoughDielectric;
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::{external_diffuse_reflectance, internal_diffuse_reflectance};
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::{Vec3, INV_PI, TWO_PI};
+use crate::models::rough_dielectric::RoughDielectric;
 use std::sync::Arc;
 
 /// What the compensation lobes need for one side of the interface.

@@ -25,12 +25,12 @@
 //! | L | UTF-8 TOML header: `model = "il-body"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples`, `max_stderr` and `mean_stderr` (relative standard errors of the entries below the grazing row), `facette_version` |
 //! | 8·n_theta²·n_phi | f64 entries, θ_i-major, then θ_o, then φ |
 
-use super::microfacet_integral::MicrofacetIntegral;
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::fresnel_dielectric;
 use crate::math::rng::{mix_seed, Pcg32, RandomSource};
 use crate::math::warp::hammersley;
 use crate::math::{fmt_num, spherical_direction, Vec3, PI};
+use crate::microfacet::integral::MicrofacetIntegral;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Distribution;
 use rayon::prelude::*;

@@ -26,12 +26,12 @@
 //! The fitted domain is σ ∈ [0, 1.4], n_i ∈ [1, 3], isotropic; other inputs are refused.
 
 use super::il_approx_coefficients as coef;
-use super::oren_nayar::oren_nayar_l1_factor;
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::fresnel_dielectric;
 use crate::math::Vec3;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking, Ndf};
+use crate::models::oren_nayar::oren_nayar_l1_factor;
 
 /// Distribution and masking combinations with fitted coefficients.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

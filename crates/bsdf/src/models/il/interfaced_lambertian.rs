@@ -31,25 +31,24 @@
 //! Flat IL is `evaluation`-independent (closed form). IL with n_i = 1 is the exact
 //! Oren–Nayar model when the distribution is Gaussian with V-cavity masking.
 
-use super::cosine_lobe::sample_cosine_same_side;
 use super::il_approx::IlApprox;
 use super::il_table::BodyTable;
-use super::microfacet_integral::MicrofacetIntegral;
-use super::oren_nayar::QUADRATURE_SEED;
 use super::vcavity::{self, IlFacet, Orders};
-use super::{flip, to_upper_pair};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
-use crate::error::{check_range, Bounds, ParamError, ParamResult};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
+use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
+use crate::error::{ParamError, ParamResult};
 use crate::fresnel::{
     external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance,
 };
+use crate::math::cosine_lobe::sample_cosine_same_side;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI};
+use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
-use crate::spec::params::check_spectrum;
+use crate::two_sided::OpaqueBsdf;
 use std::sync::Arc;
 
 /// How the body term is evaluated.
@@ -139,19 +138,13 @@ impl InterfacedLambertian {
         evaluation: BodyEvaluation,
         scattering: Scattering,
     ) -> ParamResult<Self> {
-        check_spectrum("kd", kd, 0.0, 1.0)?;
+        check_reflectance("kd", kd)?;
         check_range("ni", ni, 1.0, 10.0, Bounds::Closed)?;
         let re = external_diffuse_reflectance(ni);
         let ri = internal_diffuse_reflectance(ni);
         let body_factor = kd.map(|k| k / (ni * ni * (1.0 - k * ri)));
         if let BodyEvaluation::Quadrature { samples } = evaluation {
-            if samples < 8 {
-                return Err(ParamError::OutOfRange {
-                    name: "samples".into(),
-                    value: samples as f64,
-                    expected: "samples >= 8".into(),
-                });
-            }
+            check_min_count("samples", samples, 8)?;
         }
         let integral = match &lobe {
             Some(l) => Some(MicrofacetIntegral::new(l.ndf.clone(), l.masking)?),
@@ -314,7 +307,7 @@ impl InterfacedLambertian {
     }
 }
 
-impl Bsdf for InterfacedLambertian {
+impl OpaqueBsdf for InterfacedLambertian {
     fn flags(&self) -> LobeFlags {
         let spec = if self.lobe.is_some() {
             LobeFlags::GLOSSY_REFLECTION
@@ -331,9 +324,7 @@ impl Bsdf for InterfacedLambertian {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return Spectrum::ZERO;
-        };
+        let (o, i) = (wo, wi);
         let v = self.single(o, i, 1, rng).0 + self.multiple(o, i, rng);
         if v.is_finite() {
             v
@@ -350,9 +341,7 @@ impl Bsdf for InterfacedLambertian {
         samples: usize,
         rng: &mut dyn RandomSource,
     ) -> (Spectrum, Spectrum) {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return (Spectrum::ZERO, Spectrum::ZERO);
-        };
+        let (o, i) = (wo, wi);
         let (single, single_se) = self.single(o, i, samples.max(2), rng);
         if self.scattering == Scattering::Single || self.lobe.is_none() {
             return (single, single_se);
@@ -368,11 +357,7 @@ impl Bsdf for InterfacedLambertian {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
+        let o = wo;
         let ps = self.specular_choice(o);
         let choose_specular = rng.next_f64() < ps;
         let Some(lobe) = &self.lobe else {
@@ -388,11 +373,10 @@ impl Bsdf for InterfacedLambertian {
                 });
             }
             let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
-            let i = if below { flip(wi) } else { wi };
             // f_b cos/((1 − F) cos/π) = K_d T(i)/(n_i²(1 − K_d r_i)).
             return Some(BsdfSample {
                 wi,
-                weight: self.body_factor * self.transmittance(i.z),
+                weight: self.body_factor * self.transmittance(wi.z),
                 pdf: (1.0 - ps) * pdf,
                 lobe: LobeFlags::DIFFUSE_REFLECTION,
                 eta: 1.0,
@@ -417,7 +401,7 @@ impl Bsdf for InterfacedLambertian {
             return None;
         }
         Some(BsdfSample {
-            wi: if below { flip(i) } else { i },
+            wi: i,
             weight,
             pdf,
             lobe: lobe_flag,
@@ -426,9 +410,7 @@ impl Bsdf for InterfacedLambertian {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return 0.0;
-        };
+        let (o, i) = (wo, wi);
         let ps = self.specular_choice(o);
         let spec = match &self.lobe {
             Some(l) => ps * l.pdf(o, i),

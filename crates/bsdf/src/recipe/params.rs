@@ -173,10 +173,11 @@ impl<'a> Params<'a> {
     }
 }
 
-/// Checks every component of a spectrum against a range.
-pub fn check_spectrum(name: &str, s: Spectrum, lo: f64, hi: f64) -> ParamResult<Spectrum> {
-    for k in 0..crate::math::spectrum::CHANNELS {
-        crate::error::check_range(name, s[k], lo, hi, crate::error::Bounds::Closed)?;
+/// The error of a key whose value is not one of `valid`.
+pub fn choice(what: &str, given: &str, valid: &[&str]) -> ParamError {
+    ParamError::UnknownChoice {
+        what: what.into(),
+        given: given.into(),
+        valid: valid.join(", "),
     }
-    Ok(s)
 }

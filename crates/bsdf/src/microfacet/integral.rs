@@ -32,6 +32,11 @@ pub struct MicrofacetIntegral {
     pub masking: Masking,
 }
 
+/// Seed of the frozen quadrature point sets of the models that evaluate this integral
+/// deterministically (`evaluation = "quadrature"`): fixed so that evaluation is
+/// deterministic; each model draws its own stream of it.
+pub const QUADRATURE_SEED: u64 = 0x005e_ed0f_fac7;
+
 /// Number of independent rotations of the QMC point set (gives the standard error).
 const QMC_ROTATIONS: usize = 8;
 

@@ -21,21 +21,17 @@
 //!   that it is positive wherever a walk can exit.
 
 use super::compensated_conductor::CompensatedConductor;
-use super::rough_conductor::RoughConductor;
+use super::random_walk::{check_lobe, PROXY_COSINE_SHARE};
 use super::smith_microsurface::{FacetScattering, HeightDistribution, Microsurface};
-use super::{flip, to_upper_pair};
-use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags};
+use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
-use crate::math::{reflect, Vec3};
-use crate::microfacet::specular_lobe::NormalSampling;
-use crate::microfacet::Masking;
-
-/// Share of the cosine density in the MIS proxy.
-pub(crate) const PROXY_COSINE_SHARE: f64 = 1e-3;
+use crate::math::{reflect, to_upper_pair, Vec3};
+use crate::models::rough_conductor::RoughConductor;
+use crate::two_sided::OpaqueBsdf;
 
 /// Mirror facets with a conductor's Fresnel term.
 #[derive(Clone, Debug)]
@@ -146,27 +142,7 @@ impl MultipleScatteringConductor {
     }
 }
 
-/// The multiple-scattering models' requirements on the lobe they extend.
-pub(crate) fn check_lobe(masking: Masking, sampling: NormalSampling) -> ParamResult<()> {
-    if masking != Masking::SmithCorrelated {
-        return Err(ParamError::Invalid(format!(
-            "scattering = \"multiple\" walks on the Smith microsurface, whose first order is the \
-             height-correlated Smith masking: use masking = \"smith-correlated\" (the default \
-             with scattering = \"multiple\"), got \"{}\"",
-            masking.name()
-        )));
-    }
-    if sampling != NormalSampling::Visible {
-        return Err(ParamError::Invalid(
-            "scattering = \"multiple\" samples by the random walk, which draws visible normals \
-             (HHdD16): `sampling` does not apply"
-                .into(),
-        ));
-    }
-    Ok(())
-}
-
-impl Bsdf for MultipleScatteringConductor {
+impl OpaqueBsdf for MultipleScatteringConductor {
     fn flags(&self) -> LobeFlags {
         LobeFlags::GLOSSY_REFLECTION
     }
@@ -180,9 +156,7 @@ impl Bsdf for MultipleScatteringConductor {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
-        let Some((o, i)) = to_upper_pair(wo, wi) else {
-            return Spectrum::ZERO;
-        };
+        let (o, i) = (wo, wi);
         // The walk enters from the more masked of the two directions (the estimator's
         // variance, `Microsurface::walk_from_first`); the conductor is reciprocal, so the
         // transport mode does not matter.
@@ -206,16 +180,11 @@ impl Bsdf for MultipleScatteringConductor {
         ctx: &BsdfContext,
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
-        if wo.z == 0.0 {
-            return None;
-        }
-        let below = wo.z < 0.0;
-        let o = if below { flip(wo) } else { wo };
-        let exit = self.surface.walk(&self.facets, o, rng)?;
+        let exit = self.surface.walk(&self.facets, wo, rng)?;
         if exit.dir.z <= 0.0 {
             return None;
         }
-        let wi = if below { flip(exit.dir) } else { exit.dir };
+        let wi = exit.dir;
         let pdf = self.pdf(wo, wi, ctx);
         (pdf > 0.0 && exit.weight.is_finite()).then_some(BsdfSample {
             wi,
@@ -227,11 +196,8 @@ impl Bsdf for MultipleScatteringConductor {
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> f64 {
-        let Some((_, i)) = to_upper_pair(wo, wi) else {
-            return 0.0;
-        };
         (1.0 - PROXY_COSINE_SHARE) * self.proxy.pdf(wo, wi, ctx)
-            + PROXY_COSINE_SHARE * cosine_hemisphere_pdf(i)
+            + PROXY_COSINE_SHARE * cosine_hemisphere_pdf(wi)
     }
 
     fn lobe_width(&self) -> f64 {

@@ -1,0 +1,40 @@
+//! The `kelemen` material: KSK01's coupled specular-matte BRDF, its albedo tables built
+//! once per recipe (a textured matte colour shares them).
+
+use super::{keys, MaterialRecipe};
+use crate::checks::check_ior;
+use crate::error::ParamResult;
+use crate::fresnel::Fresnel;
+use crate::math::spectrum::Spectrum;
+use crate::microfacet::half_vector_density::HalfVectorDensity;
+use crate::models::Kelemen;
+use crate::recipe::params::Params;
+use std::sync::Arc;
+
+pub(super) const KELEMEN_KEYS: &[&str] = &[
+    "distribution",
+    "alpha",
+    "exponent",
+    "ior",
+    "kd",
+    "table_samples",
+];
+
+pub(super) fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
+    let name = p.str("distribution")?.unwrap_or("ward");
+    let rough = match name {
+        "phong" => p.required_f64("exponent")?,
+        _ => p.required_f64("alpha")?,
+    };
+    let density = HalfVectorDensity::new(name, rough)?;
+    let ior = check_ior(p.f64_or("ior", 1.5)?)?;
+    let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
+    let samples = p.usize("table_samples")?.unwrap_or(16384);
+    p.finish(&keys(KELEMEN_KEYS, false))?;
+    Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::new(
+        density,
+        Fresnel::Dielectric { eta: ior },
+        kd,
+        samples,
+    )?)))
+}
