@@ -11,6 +11,8 @@
 //!   KSK01's half-vector densities; the shared specular microfacet lobe.
 //! - [`fresnel`]: exact dielectric and conductor Fresnel, Schlick, r_e and r_i.
 //! - [`checks`]: the valid range of every shared parameter, defined once.
+//! - [`finite`]: the one guard that keeps non-finite values from a renderer (and fails
+//!   loudly in tests).
 //! - [`bsdf`]: the BSDF interface (`eval`, `sample`, `pdf`, flags, transport mode,
 //!   stochastic evaluation).
 //! - [`models`]: one file per model.
@@ -31,6 +33,7 @@
 pub mod bsdf;
 pub mod checks;
 pub mod error;
+pub mod finite;
 pub mod fresnel;
 pub mod math;
 pub mod microfacet;

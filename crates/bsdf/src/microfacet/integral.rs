@@ -21,6 +21,7 @@
 //!   Cranley–Patterson rotations of a Hammersley set), with its standard error.
 
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::math::rng::RandomSource;
 use crate::math::warp::hammersley;
 use crate::math::{Vec2, Vec3};
@@ -70,11 +71,13 @@ impl MicrofacetIntegral {
             return 0.0;
         }
         let v = h(m) * self.ndf.d(m) * g * im * om / (i.z * o.z * pdf);
-        if v.is_finite() {
-            v
-        } else {
-            0.0
-        }
+        guard(v, || {
+            format!(
+                "microfacet integral of {} ({}) at i = {i:?}, o = {o:?}, m = {m:?}",
+                self.ndf.describe(),
+                self.masking.name()
+            )
+        })
     }
 
     /// One-microfacet unbiased estimate [IL18 eq. 28].

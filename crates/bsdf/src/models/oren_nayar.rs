@@ -21,6 +21,7 @@
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::ParamResult;
+use crate::finite::guard;
 use crate::math::cosine_lobe::sample_cosine_same_side;
 use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
@@ -203,11 +204,10 @@ pub fn oren_nayar_l1_factor(sigma: f64, c: [f64; 3], i: Vec3, o: Vec3) -> f64 {
     let tan_b = beta.tan();
     let tan_ab = (0.5 * (alpha + beta)).tan();
     let v = c1 + cos_dphi * c2 * tan_b + (1.0 - cos_dphi.abs()) * c3 * tan_ab;
-    if v.is_finite() {
-        v.max(0.0)
-    } else {
-        0.0
-    }
+    guard(v, || {
+        format!("Oren–Nayar L1 factor (sigma = {sigma}, c = {c:?}) at i = {i:?}, o = {o:?}")
+    })
+    .max(0.0)
 }
 
 #[derive(Clone, Debug)]

@@ -28,6 +28,7 @@
 
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::fresnel::fresnel_dielectric;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -209,12 +210,19 @@ impl RoughDielectric {
         if d == 0.0 {
             return Spectrum::ZERO;
         }
+        // |i·n||o·n| underflows to 0 when both directions lie within ~1e-154 of the tangent
+        // plane (the NaN sweep's grazing pairs); G underflows with it, and f would be 0/0.
+        // Such pairs are the tangent plane itself, where `eval` already returns 0.
+        let cos_io = (i.z * o.z).abs();
+        if cos_io == 0.0 {
+            return Spectrum::ZERO;
+        }
         let g = lobe.masking.g(&lobe.ndf, i, o, h);
         let (ni, nt) = self.indices(i);
         let ih = i.dot(h);
         let f = fresnel_dielectric(ih.abs(), nt / ni);
         if i.z * o.z > 0.0 {
-            self.reflect_tint * (f * d * g / (4.0 * (i.z * o.z).abs()))
+            self.reflect_tint * (f * d * g / (4.0 * cos_io))
         } else {
             let no = nt;
             let oh = o.dot(h);
@@ -222,8 +230,7 @@ impl RoughDielectric {
             if denom == 0.0 {
                 return Spectrum::ZERO;
             }
-            let v =
-                (ih * oh).abs() / (i.z * o.z).abs() * no * no * (1.0 - f) * g * d / (denom * denom);
+            let v = (ih * oh).abs() / cos_io * no * no * (1.0 - f) * g * d / (denom * denom);
             self.transmit_tint * v
         }
     }
@@ -249,12 +256,13 @@ impl Bsdf for RoughDielectric {
             TransportMode::Radiance => (wi, wo),
             TransportMode::Importance => (wo, wi),
         };
-        let v = self.value(lobe, i, o);
-        if v.is_finite() {
-            v
-        } else {
-            Spectrum::ZERO
-        }
+        guard(self.value(lobe, i, o), || {
+            format!(
+                "{} eval(wo = {wo:?}, wi = {wi:?}, {:?})",
+                self.describe(),
+                ctx.mode
+            )
+        })
     }
 
     fn sample(
@@ -369,11 +377,9 @@ impl Bsdf for RoughDielectric {
             }
             pm * (1.0 - f) * n_t * n_t * wih.abs() / (denom * denom)
         };
-        if p.is_finite() {
-            p
-        } else {
-            0.0
-        }
+        guard(p, || {
+            format!("{} pdf(wo = {wo:?}, wi = {wi:?})", self.describe())
+        })
     }
 
     fn lobe_width(&self) -> f64 {

@@ -8,6 +8,7 @@
 //! ([`super::PointReferenceBsdf`]), which differ only in D, its sampler and I.
 
 use crate::bsdf::{BsdfSample, LobeFlags};
+use crate::finite::guard;
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -42,10 +43,9 @@ pub(crate) fn eval_with_d(
     if !(io > 0.0 && ii > 0.0) {
         return Spectrum::ZERO;
     }
-    let v = d / (4.0 * io * ii);
-    if !v.is_finite() {
-        return Spectrum::ZERO;
-    }
+    let v = guard(d / (4.0 * io * ii), || {
+        format!("glint patch reflection at o = {o:?}, i = {i:?}: D = {d}, I(o) = {io}, I(i) = {ii}")
+    });
     p.tint() * p.fresnel().eval(cos_oh) * v
 }
 
@@ -109,9 +109,5 @@ pub(crate) fn pdf(p: &impl PatchReflection, o: Vec3, i: Vec3) -> f64 {
         return 0.0;
     }
     let v = p.d(h) * h.z / (4.0 * cos_oh);
-    if v.is_finite() {
-        v
-    } else {
-        0.0
-    }
+    guard(v, || format!("glint patch pdf at o = {o:?}, i = {i:?}"))
 }

@@ -37,6 +37,7 @@ use super::vcavity::{self, IlFacet, Orders};
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::fresnel::{
     external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance,
 };
@@ -326,11 +327,9 @@ impl OpaqueBsdf for InterfacedLambertian {
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
         let (o, i) = (wo, wi);
         let v = self.single(o, i, 1, rng).0 + self.multiple(o, i, rng);
-        if v.is_finite() {
-            v
-        } else {
-            Spectrum::ZERO
-        }
+        guard(v, || {
+            format!("{} eval(wo = {wo:?}, wi = {wi:?})", self.describe())
+        })
     }
 
     fn eval_estimate(

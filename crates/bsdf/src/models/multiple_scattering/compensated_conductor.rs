@@ -22,6 +22,7 @@
 use super::albedo_tables::{table_alpha, AlbedoTable, TableFresnel};
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::math::quadrature::GaussLegendre;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -156,11 +157,9 @@ impl OpaqueBsdf for CompensatedConductor {
         let (o, i) = (wo, wi);
         let ps = self.single_share(o);
         let p = ps * self.lobe().pdf(o, i) + (1.0 - ps) * self.table.lobe_density(i.z, self.alpha);
-        if p.is_finite() {
-            p
-        } else {
-            0.0
-        }
+        guard(p, || {
+            format!("{} pdf(wo = {wo:?}, wi = {wi:?})", self.describe())
+        })
     }
 
     fn lobe_width(&self) -> f64 {

@@ -29,6 +29,7 @@
 use super::albedo_tables::{table_alpha, AlbedoTable, TableFresnel};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::fresnel::{external_diffuse_reflectance, internal_diffuse_reflectance};
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -171,11 +172,13 @@ impl Bsdf for CompensatedDielectric {
             TransportMode::Importance => (wo, wi),
         };
         let v = self.single.eval(wo, wi, ctx, rng) + self.compensation(i, o);
-        if v.is_finite() {
-            v
-        } else {
-            Spectrum::ZERO
-        }
+        guard(v, || {
+            format!(
+                "{} eval(wo = {wo:?}, wi = {wi:?}, {:?})",
+                self.describe(),
+                ctx.mode
+            )
+        })
     }
 
     fn sample(
@@ -244,11 +247,9 @@ impl Bsdf for CompensatedDielectric {
             here.transmitted * self.side(wi).table.lobe_density(wi.z.abs(), self.alpha)
         };
         let p = ps * self.single.pdf(wo, wi, ctx) + (1.0 - ps) * lobe;
-        if p.is_finite() {
-            p
-        } else {
-            0.0
-        }
+        guard(p, || {
+            format!("{} pdf(wo = {wo:?}, wi = {wi:?})", self.describe())
+        })
     }
 
     fn lobe_width(&self) -> f64 {

@@ -25,6 +25,7 @@ use super::random_walk::{check_lobe, PROXY_COSINE_SHARE};
 use super::smith_microsurface::{FacetScattering, HeightDistribution, Microsurface};
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -167,11 +168,9 @@ impl OpaqueBsdf for MultipleScatteringConductor {
         };
         let higher = self.surface.estimate(&self.facets, light, view, 2, rng) / view.z;
         let v = self.single.eval(wo, wi, ctx, rng) + higher;
-        if v.is_finite() {
-            v
-        } else {
-            Spectrum::ZERO
-        }
+        guard(v, || {
+            format!("{} eval(wo = {wo:?}, wi = {wi:?})", self.describe())
+        })
     }
 
     fn sample(

@@ -33,6 +33,7 @@ use super::random_walk::{check_lobe, PROXY_COSINE_SHARE};
 use super::smith_microsurface::{FacetScattering, HeightDistribution, Microsurface};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::fresnel::fresnel_dielectric;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
@@ -213,11 +214,13 @@ impl Bsdf for MultipleScatteringDielectric {
             self.estimate_orders(o, i, 2, rng) * (r * r)
         };
         let v = self.single.eval(wo, wi, ctx, rng) + higher;
-        if v.is_finite() {
-            v
-        } else {
-            Spectrum::ZERO
-        }
+        guard(v, || {
+            format!(
+                "{} eval(wo = {wo:?}, wi = {wi:?}, {:?})",
+                self.describe(),
+                ctx.mode
+            )
+        })
     }
 
     fn sample(

@@ -45,6 +45,7 @@
 //! default, and the standard Gaussian); the tests check that they give the same BSDF.
 
 use crate::error::{ParamError, ParamResult};
+use crate::finite::guard;
 use crate::math::rng::RandomSource;
 use crate::math::special::{erfc, erfinv};
 use crate::math::spectrum::Spectrum;
@@ -256,12 +257,12 @@ impl Microsurface {
         if !(a > 0.0) {
             return 0.0;
         }
-        let v = wm * self.ndf.d(m) / a;
-        if v.is_finite() {
-            v
-        } else {
-            0.0
-        }
+        guard(wm * self.ndf.d(m) / a, || {
+            format!(
+                "visible density of {} at w = {w:?}, m = {m:?}",
+                self.ndf.describe()
+            )
+        })
     }
 
     /// Draws a normal from D_w for any direction w (the core's samplers above the horizon;
@@ -415,16 +416,24 @@ impl Microsurface {
                 return 0.0;
             }
             // Λ_d c^{Λ_d} (−ln c) · (1 − e^{δ ln c}) / (−δ ln c), δ = Λ_o − Λ_d, written with
-            // expm1 so that it stays accurate when Λ_o ≈ Λ_d or both are tiny.
+            // expm1 so that it stays accurate when Λ_o ≈ Λ_d or both are tiny: with
+            // φ(x) = (e^x − 1)/x and x = δ ln c, E = Λ_d (−ln c) c^{Λ_d} φ(x). For x > 0
+            // (Λ_d > Λ_o) φ(x) grows like e^x while c^{Λ_d} shrinks: a nearly horizontal
+            // upward d (Λ_d ~ 10⁴) made them ∞ and 0, and E NaN instead of ≈ 1 − c^{Λ_d}.
+            // The same value is c^{Λ_o} φ(−x) in place of c^{Λ_d} φ(x) (both are
+            // (c^{Λ_d} − c^{Λ_o})/x), whose factors stay in [0, 1].
             let l = c.ln();
             let x = (lo - ld) * l;
-            let ratio = if x == 0.0 { 1.0 } else { x.exp_m1() / x };
-            let e = ld * (ld * l).exp() * (-l) * ratio;
-            if e.is_finite() {
-                e.clamp(0.0, 1.0)
+            let phi = |x: f64| if x == 0.0 { 1.0 } else { x.exp_m1() / x };
+            let e = if x > 0.0 {
+                ld * (lo * l).exp() * (-l) * phi(-x)
             } else {
-                0.0
-            }
+                ld * (ld * l).exp() * (-l) * phi(x)
+            };
+            guard(e, || {
+                format!("expected next escape along d = {d:?} from C1 = {c} toward o = {o:?}")
+            })
+            .clamp(0.0, 1.0)
         } else if d.z < 0.0 {
             if !ld.is_finite() {
                 return c.powf(lo);
@@ -492,10 +501,9 @@ impl Microsurface {
                 let e = self.expected_next_escape(d, h, o_side);
                 if e > 0.0 {
                     let p = facets.phase(self, wi, o_side, inside, false);
-                    let v = throughput * p * e;
-                    if v.is_finite() {
-                        sum += v;
-                    }
+                    sum += guard(throughput * p * e, || {
+                        format!("walk next-event term at order {order}, toward o = {o:?}")
+                    });
                 }
             }
             match self.next_height(d, h, rng.next_f64()) {
@@ -524,11 +532,12 @@ impl Microsurface {
                 break;
             }
         }
-        if sum.is_finite() {
-            sum
-        } else {
-            Spectrum::ZERO
-        }
+        guard(sum, || {
+            format!(
+                "walk estimate of {} from i = {i:?} toward o = {o:?}",
+                self.ndf.describe()
+            )
+        })
     }
 }
 
@@ -705,6 +714,25 @@ mod tests {
                 println!("{:?} θ={theta}: {}", s.ndf, out.summary());
                 assert!(out.passes(1e-3), "{:?} θ={theta}: {}", s.ndf, out.summary());
             }
+        }
+    }
+
+    #[test]
+    fn expected_next_escape_is_finite_for_a_grazing_upward_path() {
+        // d barely above the horizon (Λ_d ≈ 6·10³ for GGX α = 0.8) toward the normal
+        // (Λ_o = 0): E = 1 − c^{Λ_d} ≈ 1. The first closed form gave 0 · ∞ = NaN here.
+        let s = Microsurface::new(
+            Ndf::Ggx(Ggx::isotropic(0.8).unwrap()),
+            HeightDistribution::Uniform,
+        )
+        .unwrap();
+        let d = Vec3::new(-0.683, 0.730, 6.4e-5).normalize();
+        let o = Vec3::new(0.0, 0.0, 1.0);
+        for h in [-0.5, 0.0, 0.3] {
+            let e = s.expected_next_escape(d, h, o);
+            let c: f64 = s.heights().c1(h);
+            let exact = 1.0 - c.powf(s.ndf().lambda(d));
+            assert!((e - exact).abs() < 1e-12, "h = {h}: {e} vs {exact}");
         }
     }
 
