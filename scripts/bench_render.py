@@ -465,6 +465,8 @@ def main():
     ap.add_argument("--threads", type=int, default=os.cpu_count(),
                     help="threads for both renderers (default: all cores)")
     ap.add_argument("--markdown", metavar="FILE", help="also write the Markdown table here")
+    ap.add_argument("--kernel", nargs="+", default=["scalar"], choices=["scalar", "packet"],
+                    help="facette's render kernels to time (default: scalar)")
     ap.add_argument("--facette", metavar="BINARY", default=FACETTE,
                     help="the facette binary (default: target/release/facette of the repo)")
     args = ap.parse_args()
@@ -498,6 +500,14 @@ def main():
         print("note: `facette render` has no --sampler flag: facette renders with the scene's"
               " own sampler")
         variants = [("facette (scene's sampler)", [])]
+    if args.kernel != ["scalar"]:
+        if "--kernel" not in facette_help():
+            sys.exit("error: this facette has no --kernel flag")
+        variants = [
+            (f"{name} {k}" if k != "scalar" else name, flags + ["--kernel", k])
+            for k in args.kernel
+            for name, flags in variants
+        ]
 
     info = (
         f"Mitsuba {mi.__version__} {mi.variant()}, {args.threads} threads,"

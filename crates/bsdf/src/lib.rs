@@ -35,6 +35,7 @@ pub mod checks;
 pub mod error;
 pub mod finite;
 pub mod fresnel;
+pub mod lanes;
 pub mod math;
 pub mod microfacet;
 pub mod models;

@@ -5,6 +5,7 @@
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use facette_render::integrator::Strategy;
+use facette_render::kernel::Kernel;
 use facette_render::render::{render, RenderOptions, RenderStats};
 use facette_render::sampler::SamplerKind;
 use facette_render::scene::{load_scene_with, LoadOptions, Scene};
@@ -61,6 +62,11 @@ pub struct RenderArgs {
     /// Sobol in Morton order, the default), `independent` or `stratified`.
     #[arg(long, value_name = "NAME", value_parser = parse_sampler)]
     sampler: Option<SamplerKind>,
+    /// Render kernel (overrides the scene's `[integrator] kernel`): `scalar` (one camera
+    /// sample at a time, the default) or `packet` (eight in flight per thread, materials
+    /// in f32 lanes; see docs/performance.md).
+    #[arg(long, value_name = "NAME", value_parser = parse_kernel)]
+    kernel: Option<Kernel>,
     /// Render part K of N of the samples (K from 0) and write the exact partial result to
     /// a `.fcpart` file for `facette merge` (distributed rendering; see docs/scale-out.md).
     #[arg(long, value_name = "K/N")]
@@ -78,6 +84,12 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
             SamplerKind::NAMES.join(", ")
         )
     })
+}
+
+/// Parses a kernel name, listing the valid ones when it is unknown.
+fn parse_kernel(s: &str) -> Result<Kernel, String> {
+    Kernel::parse(s)
+        .ok_or_else(|| format!("unknown kernel `{s}`; valid: {}", Kernel::NAMES.join(", ")))
 }
 
 /// Parses `K/N` with 0 ≤ K < N.
@@ -129,6 +141,7 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
         time_limit: a.time_limit,
         part: None,
         sampler: a.sampler,
+        kernel: a.kernel,
         strategy: match a.strategy {
             StrategyArg::Mis => Strategy::Mis,
             StrategyArg::Nee => Strategy::NeeOnly,

@@ -33,7 +33,7 @@ pub const CAMERA_DIMENSIONS: u32 = 4;
 pub const VERTEX_DIMENSIONS: u32 = 7;
 
 #[inline]
-fn power_heuristic(a: f64, b: f64) -> f64 {
+pub(crate) fn power_heuristic(a: f64, b: f64) -> f64 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 == 0.0 {
         0.0

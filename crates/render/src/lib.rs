@@ -23,6 +23,7 @@ pub mod film;
 pub mod geometry;
 pub mod image;
 pub mod integrator;
+pub mod kernel;
 pub mod lights;
 pub mod materials;
 pub mod partial_film;

@@ -15,6 +15,7 @@
 //! default (`encoding` overrides). A roughness texture's value is its channel average.
 
 use crate::image::{read_image, ColorEncoding, ImageNormalMapReader, MipMap, Texture, WrapMode};
+use facette_bsdf::models::LaneBsdf;
 use facette_bsdf::recipe::MaterialRecipe;
 use facette_bsdf::{Bsdf, Spectrum};
 use glam::DVec2;
@@ -35,6 +36,8 @@ pub struct SceneMaterial {
     pub name: String,
     recipe: MaterialRecipe,
     fixed: Option<Arc<dyn Bsdf>>,
+    /// The lane model of an untextured material that vectorizes (the packet kernel's).
+    lane: Option<LaneBsdf>,
     textures: Vec<TexturedParam>,
 }
 
@@ -126,10 +129,12 @@ impl SceneMaterial {
         // anyway so that a material that cannot be built fails at load time.
         let built = recipe.build().map_err(|e| e.to_string())?;
         let fixed = (textures.is_empty() && !recipe.varies_per_hit()).then_some(built);
+        let lane = fixed.as_ref().and_then(|_| recipe.lane_model());
         Ok(SceneMaterial {
             name: name.to_string(),
             recipe,
             fixed,
+            lane,
             textures,
         })
     }
@@ -138,12 +143,20 @@ impl SceneMaterial {
     pub fn from_recipe(name: &str, recipe: MaterialRecipe) -> Result<SceneMaterial, String> {
         let built = recipe.build().map_err(|e| e.to_string())?;
         let fixed = (!recipe.varies_per_hit()).then_some(built);
+        let lane = fixed.as_ref().and_then(|_| recipe.lane_model());
         Ok(SceneMaterial {
             name: name.into(),
             recipe,
             fixed,
+            lane,
             textures: Vec::new(),
         })
+    }
+
+    /// The material's lane model, where it has one (see `facette_bsdf::lanes`).
+    #[inline]
+    pub fn lane_bsdf(&self) -> Option<&LaneBsdf> {
+        self.lane.as_ref()
     }
 
     pub fn is_textured(&self) -> bool {

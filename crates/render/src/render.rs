@@ -6,10 +6,12 @@
 //! rendered separately and merged exactly.
 
 use crate::film::Film;
-use crate::geometry::Vec2;
+use crate::geometry::{Ray, RayDifferential, Vec2};
 use crate::integrator::{radiance, Strategy};
-use crate::sampler::{PixelSampler, SamplerKind};
+use crate::kernel::{packet, Kernel};
+use crate::sampler::{PixelSampler, SampleStream, SamplerKind};
 use crate::scene::Scene;
+use facette_bsdf::Spectrum;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -30,6 +32,8 @@ pub struct RenderOptions {
     pub strategy: Strategy,
     /// The pixel sampler (the scene's when `None`).
     pub sampler: Option<SamplerKind>,
+    /// The render kernel (the scene's when `None`).
+    pub kernel: Option<Kernel>,
 }
 
 impl Default for RenderOptions {
@@ -42,6 +46,7 @@ impl Default for RenderOptions {
             part: None,
             strategy: Strategy::Mis,
             sampler: None,
+            kernel: None,
         }
     }
 }
@@ -82,11 +87,75 @@ fn pass_sizes(n: usize) -> Vec<usize> {
 }
 
 /// One pixel's samples of one pass.
-struct PixelSums {
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct PixelSums {
     sum: [f64; 3],
     sq: [f64; 3],
     n: u32,
     bad: u32,
+}
+
+impl PixelSums {
+    /// The radiance sums per channel.
+    #[cfg(test)]
+    pub(crate) fn sums(&self) -> [f64; 3] {
+        self.sum
+    }
+
+    /// The samples added.
+    #[cfg(test)]
+    pub(crate) fn count(&self) -> u32 {
+        self.n
+    }
+
+    /// Adds one camera sample's radiance; a non-finite or negative one is counted and
+    /// left out.
+    #[inline]
+    pub(crate) fn add(&mut self, l: Spectrum) {
+        self.n += 1;
+        if l.is_finite() && !l.has_negative() {
+            for c in 0..3 {
+                self.sum[c] += l[c];
+                self.sq[c] += l[c] * l[c];
+            }
+        } else {
+            self.bad += 1;
+        }
+    }
+}
+
+/// How camera rays are made for one render.
+#[derive(Clone, Copy)]
+pub(crate) struct CameraSampling {
+    /// Whether some material reads texture or glint footprints (only then are ray
+    /// differentials computed).
+    pub footprints: bool,
+    /// The differentials' scale for the pixel's sample count.
+    pub diff_scale: f64,
+}
+
+impl CameraSampling {
+    /// The camera ray of pixel (x, y) from the stream's first dimensions: the filter
+    /// offset (2), then the lens position (2).
+    #[inline]
+    pub(crate) fn ray(
+        &self,
+        scene: &Scene,
+        stream: &mut SampleStream,
+        x: usize,
+        y: usize,
+    ) -> (Ray, Option<RayDifferential>) {
+        let off = scene.film.filter.sample(stream.get_2d());
+        let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
+        let lens = stream.get_2d();
+        let lens = Vec2::new(lens.x, lens.y);
+        if self.footprints {
+            let (ray, rd) = scene.camera.generate_ray(fx, fy, lens);
+            (ray, Some(rd.scaled(&ray, self.diff_scale)))
+        } else {
+            (scene.camera.generate_primary_ray(fx, fy, lens), None)
+        }
+    }
 }
 
 /// Renders `scene`. `cancel` stops the render between tiles; `progress(done, total)` is
@@ -151,9 +220,12 @@ fn render_in_pool(
         }
         false
     };
-    let diff_scale = 1.0 / (spp as f64).sqrt().max(1.0);
-    // Ray differentials only serve texture and glint footprints.
-    let footprints = scene.materials.iter().any(|m| m.reads_surface_details());
+    let cameras = CameraSampling {
+        diff_scale: 1.0 / (spp as f64).sqrt().max(1.0),
+        // Ray differentials only serve texture and glint footprints.
+        footprints: scene.materials.iter().any(|m| m.reads_surface_details()),
+    };
+    let kernel = opts.kernel.unwrap_or(scene.integrator.kernel);
     let sampler = PixelSampler::new(
         opts.sampler.unwrap_or(scene.film.sampler),
         opts.seed,
@@ -181,37 +253,31 @@ fn render_in_pool(
                     if should_stop(pass) {
                         break;
                     }
-                    for x in x0..x1 {
-                        let mut p = PixelSums {
-                            sum: [0.0; 3],
-                            sq: [0.0; 3],
-                            n: 0,
-                            bad: 0,
-                        };
-                        for &s in chunk {
-                            let mut stream = sampler.stream(x, y, s as u64);
-                            let off = scene.film.filter.sample(stream.get_2d());
-                            let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
-                            let lens = stream.get_2d();
-                            let lens = Vec2::new(lens.x, lens.y);
-                            let (ray, rd) = if footprints {
-                                let (ray, rd) = scene.camera.generate_ray(fx, fy, lens);
-                                (ray, Some(rd.scaled(&ray, diff_scale)))
-                            } else {
-                                (scene.camera.generate_primary_ray(fx, fy, lens), None)
-                            };
-                            let l = radiance(scene, ray, rd, &mut stream, opts.strategy);
-                            p.n += 1;
-                            if l.is_finite() && !l.has_negative() {
-                                for c in 0..3 {
-                                    p.sum[c] += l[c];
-                                    p.sq[c] += l[c] * l[c];
+                    match kernel {
+                        Kernel::Scalar => {
+                            for x in x0..x1 {
+                                let mut p = PixelSums::default();
+                                for &s in chunk {
+                                    let mut stream = sampler.stream(x, y, s as u64);
+                                    let (ray, rd) = cameras.ray(scene, &mut stream, x, y);
+                                    p.add(radiance(scene, ray, rd, &mut stream, opts.strategy));
                                 }
-                            } else {
-                                p.bad += 1;
+                                out.push(p);
                             }
                         }
-                        out.push(p);
+                        Kernel::Packet => {
+                            let first = out.len();
+                            out.resize(first + (x1 - x0), PixelSums::default());
+                            packet::render_row(
+                                scene,
+                                &sampler,
+                                cameras,
+                                opts.strategy,
+                                (x0..x1, y),
+                                chunk,
+                                &mut out[first..],
+                            );
+                        }
                     }
                     let row = ((x1 - x0) * chunk.len()) as u64;
                     let d = done.fetch_add(row, Ordering::Relaxed) + row;

@@ -1,33 +1,37 @@
 //! Exact Fresnel reflectance of a dielectric interface for unpolarized light
 //! [WMLT07 eq. 22; IL18 eq. 8; TSBRM eq. 18].
 
+use crate::lanes::Real;
+
 /// F(c) for c = |i·m| and relative index `eta` = η_t / η_i (the index on the far side over
 /// the index on the side of i). Returns 1 under total internal reflection and at grazing
 /// incidence (unless η = 1, where the interface vanishes and F = 0).
 ///
 /// F = ½ (g−c)²/(g+c)² [1 + (c(g+c)−1)²/(c(g−c)+1)²], g = √(η² − 1 + c²).
+
 #[inline]
 pub fn fresnel_dielectric(cos_theta: f64, eta: f64) -> f64 {
-    let c = cos_theta.abs().min(1.0);
-    if eta == 1.0 {
-        return 0.0;
-    }
-    let g2 = eta * eta - 1.0 + c * c;
-    if g2 <= 0.0 || c == 0.0 {
-        return 1.0;
-    }
-    let g = g2.sqrt();
-    // g − c = (η² − 1)/(g + c): no cancellation when η → 1.
-    let gmc = (eta * eta - 1.0) / (g + c);
-    let gpc = g + c;
-    let a = gmc / gpc;
-    let num = c * gpc - 1.0;
-    let den = c * gmc + 1.0;
-    (0.5 * a * a * (1.0 + (num / den) * (num / den))).clamp(0.0, 1.0)
+    fresnel_dielectric_lanes(cos_theta, eta)
 }
 
-/// Cosine of the refracted angle, |cos θ_t|, for c = |cos θ_i| and η = η_t/η_i; `None`
-/// under total internal reflection.
+/// [`fresnel_dielectric`] over lanes (each lane its own cosine and relative index): the
+/// one source of the formula for the lab and the renderer's kernel.
+#[inline(always)]
+pub fn fresnel_dielectric_lanes<R: Real>(cos_theta: R, eta: R) -> R {
+    let c = cos_theta.abs().min(R::one());
+    let e2m1 = eta * eta - R::one();
+    let g2 = e2m1 + c * c;
+    let g = g2.sqrt();
+    let gmc = e2m1 / (g + c);
+    let gpc = g + c;
+    let a = gmc / gpc;
+    let num = c * gpc - R::one();
+    let den = c * gmc + R::one();
+    let f = (R::splat(0.5) * a * a * (R::one() + (num / den) * (num / den))).clamp(0.0, 1.0);
+    let total = g2.le(R::zero()) | c.eq(R::zero());
+    R::select(eta.eq(R::one()), R::zero(), R::select(total, R::one(), f))
+}
+
 #[inline]
 pub fn refracted_cos(cos_theta: f64, eta: f64) -> Option<f64> {
     let c = cos_theta.abs().min(1.0);

@@ -10,6 +10,7 @@
 use super::{normal_from_slopes, Distribution};
 use crate::checks::check_alpha;
 use crate::error::ParamResult;
+use crate::lanes::{LVec3, Real};
 use crate::math::special::{erf, erfc, erfinv_approx, erfinv_of_uniform};
 use crate::math::{fmt_num, Vec2, Vec3, PI, SQRT_PI, TWO_PI};
 
@@ -133,25 +134,63 @@ impl Beckmann {
     /// one square root and one division.
     #[inline]
     pub fn g1_exact_fast(&self, v: Vec3) -> f64 {
-        let s2 = self.ax2 * v.x * v.x + self.ay2 * v.y * v.y;
+        self.g1_exact_lanes::<f64>(v.into())
+    }
+
+    /// Exact G1 = 1/(1 + Λ) over lanes: the table lookup is per lane (it does not
+    /// vectorize), the rest lane-wise.
+    #[inline(always)]
+    pub fn g1_exact_lanes<R: Real>(&self, v: LVec3<R>) -> R {
+        let s2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
         let z = v.z.abs();
-        if s2 <= 0.0 {
-            return 1.0;
-        }
-        g1_exact_table().eval(z / (z + s2.sqrt()))
+        let table = g1_exact_table();
+        let g = (z / (z + s2.sqrt())).map(|y| table.eval(y));
+        R::select(s2.le(R::zero()), R::one(), g)
     }
 
     /// WMLT07 eq. 27 written with a = z/r (z = |cos θ|, r = α_v sin θ): one square root and
-    /// one division.
-    #[inline]
-    fn g1_rational_fast(&self, v: Vec3) -> f64 {
-        let r2 = self.ax2 * v.x * v.x + self.ay2 * v.y * v.y;
+    /// one division; 1 from a = 1.6 on.
+    #[inline(always)]
+    fn g1_rational_lanes<R: Real>(&self, v: LVec3<R>) -> R {
+        let r2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
         let z = v.z.abs();
-        if z * z >= 2.56 * r2 {
-            return 1.0;
-        }
         let r = r2.sqrt();
-        ((3.535 * z * r + 2.181 * z * z) / (r2 + 2.276 * z * r + 2.577 * z * z)).min(1.0)
+        let g = ((R::splat(3.535) * z * r + R::splat(2.181) * z * z)
+            / (r2 + R::splat(2.276) * z * r + R::splat(2.577) * z * z))
+            .min(R::one());
+        R::select((z * z).ge(R::splat(2.56) * r2), R::one(), g)
+    }
+
+    /// G1(v, m) in the model's form, 0 where v sees the back of m (WMLT07 eq. 7's χ⁺).
+    #[inline(always)]
+    pub fn g1_lanes<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
+        let g = match self.g1_form {
+            BeckmannG1::Exact => self.g1_exact_lanes(v),
+            BeckmannG1::Rational => self.g1_rational_lanes(v),
+        };
+        R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g)
+    }
+
+    /// D(m) = exp(−(x²/α_x² + y²/α_y²)/z²) / (π α_x α_y z⁴)  [IL18 eq. 16; WMLT07 eq. 25];
+    /// 0 below the horizon and where z⁴ underflows.
+    #[inline(always)]
+    pub fn d_lanes<R: Real>(&self, m: LVec3<R>) -> R {
+        let z2 = m.z * m.z;
+        let inv_z2 = R::one() / z2;
+        let e = (m.x * m.x * R::splat(self.inv_ax2) + m.y * m.y * R::splat(self.inv_ay2)) * inv_z2;
+        let d = R::splat(self.norm) * (-e).exp() * inv_z2 * inv_z2;
+        R::select(
+            m.z.le(R::zero()) | (z2 * z2).lt(R::splat(R::TINY)),
+            R::zero(),
+            d,
+        )
+    }
+
+    /// Visible normals over lanes: the slope inversion is per lane in f64 (a table and a
+    /// Halley step, which do not vectorize).
+    #[inline(always)]
+    pub fn sample_visible_lanes<R: Real>(&self, v: LVec3<R>, u0: R, u1: R) -> LVec3<R> {
+        LVec3::from_fn(|i| self.sample_visible(v.lane(i), Vec2::new(u0.lane(i), u1.lane(i))))
     }
 }
 
@@ -492,16 +531,7 @@ impl Distribution for Beckmann {
     /// D(m) = exp(−(x²/α_x² + y²/α_y²)/z²) / (π α_x α_y z⁴)  [IL18 eq. 16; WMLT07 eq. 25].
     #[inline]
     fn d(&self, m: Vec3) -> f64 {
-        if m.z <= 0.0 {
-            return 0.0;
-        }
-        let z2 = m.z * m.z;
-        if z2 * z2 < 1e-300 {
-            return 0.0;
-        }
-        let inv_z2 = 1.0 / z2;
-        let e = (m.x * m.x * self.inv_ax2 + m.y * m.y * self.inv_ay2) * inv_z2;
-        self.norm * (-e).exp() * inv_z2 * inv_z2
+        self.d_lanes::<f64>(m.into())
     }
 
     #[inline]
@@ -514,13 +544,7 @@ impl Distribution for Beckmann {
 
     #[inline]
     fn g1(&self, v: Vec3, m: Vec3) -> f64 {
-        if v.dot(m) * v.z <= 0.0 {
-            return 0.0;
-        }
-        match self.g1_form {
-            BeckmannG1::Exact => self.g1_exact_fast(v),
-            BeckmannG1::Rational => self.g1_rational_fast(v),
-        }
+        self.g1_lanes::<f64>(v.into(), m.into())
     }
 
     /// Samples D(m)|m·n|: slopes r(cos 2πξ2, sin 2πξ2) with r = √(−ln(1−ξ1)), stretched by

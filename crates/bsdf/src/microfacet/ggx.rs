@@ -12,6 +12,7 @@
 use super::{normal_from_slopes, visible_density, Distribution};
 use crate::checks::check_alpha;
 use crate::error::ParamResult;
+use crate::lanes::{LVec3, Real};
 use crate::math::{fmt_num, Vec2, Vec3, PI, TWO_PI};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,42 +75,87 @@ impl Ggx {
     }
 }
 
+/// The GGX formulas, written once over [`Real`] lanes: the [`Distribution`] methods are
+/// their f64 instantiation, the renderer's kernel their f32 ones.
+impl Ggx {
+    /// D(m) = 1/(π α_x α_y (x²/α_x² + y²/α_y² + z²)²)  [WMLT07 eq. 33; IL18 eq. 21],
+    /// written so that it stays finite up to the horizon; 0 below it.
+    #[inline(always)]
+    pub fn d_lanes<R: Real>(&self, m: LVec3<R>) -> R {
+        let t = m.x * m.x * R::splat(self.inv_ax2) + m.y * m.y * R::splat(self.inv_ay2) + m.z * m.z;
+        R::select(m.z.le(R::zero()), R::zero(), R::splat(self.norm) / (t * t))
+    }
+
+    /// Λ(v) = (−1 + √(1 + α_v² tan² θ_v)) / 2  [IL18 eq. 22; WMLT07 eq. 34], written as
+    /// s²/(2z(r + z)) with z = |cos θ|, s² = α_v² sin² θ, r = √(z² + s²): no cancellation
+    /// for small slopes. At the horizon Λ = ∞ (0 for the normal itself).
+    #[inline(always)]
+    pub fn lambda_lanes<R: Real>(&self, v: LVec3<R>) -> R {
+        let s2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
+        let z = v.z.abs();
+        let r = (z * z + s2).sqrt();
+        let at_horizon = R::select(s2.gt(R::zero()), R::splat(f64::INFINITY), R::zero());
+        R::select(
+            z.eq(R::zero()),
+            at_horizon,
+            s2 / (R::splat(2.0) * z * (r + z)),
+        )
+    }
+
+    /// G1 = 2z / (z + √(z² + α_v² sin² θ))  [WMLT07 eq. 34]: one square root, one division;
+    /// 0 where v sees the back of m (WMLT07 eq. 7's χ⁺).
+    #[inline(always)]
+    pub fn g1_lanes<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
+        let s2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
+        let z = v.z.abs();
+        let g = R::splat(2.0) * z / (z + (z * z + s2).sqrt());
+        R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g)
+    }
+
+    /// Visible normals of the view v (z ≥ 0) from (u0, u1) [Heitz 2018, "Sampling the GGX
+    /// Distribution of Visible Normals", listing 1]: stretch the view to unit roughness,
+    /// sample the projected disk warped toward the view, unstretch.
+    #[inline(always)]
+    pub fn sample_visible_lanes<R: Real>(&self, v: LVec3<R>, u0: R, u1: R) -> LVec3<R> {
+        let (ax, ay) = (R::splat(self.ax), R::splat(self.ay));
+        let vh = LVec3::new(ax * v.x, ay * v.y, v.z.max(R::zero())).normalize();
+        let lensq = vh.x * vh.x + vh.y * vh.y;
+        let len = lensq.sqrt();
+        let wide = lensq.gt(R::splat(1e-20));
+        let t1 = LVec3::new(
+            R::select(wide, -vh.y / len, R::one()),
+            R::select(wide, vh.x / len, R::zero()),
+            R::zero(),
+        );
+        let t2 = vh.cross(t1);
+        let r = u0.sqrt();
+        let (s, c) = (R::splat(TWO_PI) * u1).sin_cos();
+        let p1 = r * c;
+        let p2 = r * s;
+        let h = R::splat(0.5) * (R::one() + vh.z);
+        let p2 = (R::one() - h) * (R::one() - p1 * p1).max(R::zero()).sqrt() + h * p2;
+        let nz = (R::one() - p1 * p1 - p2 * p2).max(R::zero()).sqrt();
+        let nh = t1.scale(p1).add(t2.scale(p2)).add(vh.scale(nz));
+        LVec3::new(ax * nh.x, ay * nh.y, nh.z.max(R::splat(R::TINY))).normalize()
+    }
+}
+
 impl Distribution for Ggx {
     /// D(m) = 1 / (π α_x α_y z⁴ (1 + (x²/α_x² + y²/α_y²)/z²)²)  [IL18 eq. 21 corrected;
     /// WMLT07 eq. 33 when isotropic].
     #[inline]
     fn d(&self, m: Vec3) -> f64 {
-        if m.z <= 0.0 {
-            return 0.0;
-        }
-        // Written as 1/(π α_x α_y (x²/α_x² + y²/α_y² + z²)²), finite up to the horizon.
-        let t = m.x * m.x * self.inv_ax2 + m.y * m.y * self.inv_ay2 + m.z * m.z;
-        self.norm / (t * t)
+        self.d_lanes::<f64>(m.into())
     }
 
-    /// Λ(v) = (−1 + √(1 + α_v² tan² θ_v)) / 2  [IL18 eq. 22; WMLT07 eq. 34], written as
-    /// s²/(2z(r + z)) with z = |cos θ|, s² = α_v² sin² θ, r = √(z² + s²): no cancellation
-    /// for small slopes.
     #[inline]
     fn lambda(&self, v: Vec3) -> f64 {
-        let s2 = self.ax2 * v.x * v.x + self.ay2 * v.y * v.y;
-        let z = v.z.abs();
-        if z == 0.0 {
-            return if s2 > 0.0 { f64::INFINITY } else { 0.0 };
-        }
-        let r = (z * z + s2).sqrt();
-        s2 / (2.0 * z * (r + z))
+        self.lambda_lanes::<f64>(v.into())
     }
 
-    /// G1 = 2z / (z + √(z² + α_v² sin² θ))  [WMLT07 eq. 34]: one square root, one division.
     #[inline]
     fn g1(&self, v: Vec3, m: Vec3) -> f64 {
-        if v.dot(m) * v.z <= 0.0 {
-            return 0.0;
-        }
-        let s2 = self.ax2 * v.x * v.x + self.ay2 * v.y * v.y;
-        let z = v.z.abs();
-        2.0 * z / (z + (z * z + s2).sqrt())
+        self.g1_lanes::<f64>(v.into(), m.into())
     }
 
     /// Samples D(m)|m·n|: unit slope radius r = √(ξ1/(1−ξ1)) at angle 2πξ2, stretched by
@@ -143,23 +189,7 @@ impl Distribution for Ggx {
     /// (models/multiple_scattering/smith_microsurface.rs).
     #[inline]
     fn sample_visible(&self, v: Vec3, u: Vec2) -> Vec3 {
-        let vh = Vec3::new(self.ax * v.x, self.ay * v.y, v.z.max(0.0)).normalize();
-        let lensq = vh.x * vh.x + vh.y * vh.y;
-        let t1 = if lensq > 1e-20 {
-            Vec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
-        } else {
-            Vec3::X
-        };
-        let t2 = vh.cross(t1);
-        let r = u.x.sqrt();
-        let (s, c) = (TWO_PI * u.y).sin_cos();
-        let p1 = r * c;
-        let mut p2 = r * s;
-        let h = 0.5 * (1.0 + vh.z);
-        p2 = (1.0 - h) * (1.0 - p1 * p1).max(0.0).sqrt() + h * p2;
-        let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-        let ne = Vec3::new(self.ax * nh.x, self.ay * nh.y, nh.z.max(1e-300));
-        ne.normalize()
+        self.sample_visible_lanes::<f64>(v.into(), u.x, u.y).into()
     }
 
     #[inline]

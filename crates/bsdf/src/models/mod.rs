@@ -11,6 +11,9 @@
 //!   the Smith microsurface (HHdD16) and the Kulla–Conty compensation lobe with its albedo
 //!   tables (KC17).
 //! - [`glint`]: the CCM19 glint BRDF.
+//! - [`lane_models`]: Lambert and the rough conductor and dielectric written over
+//!   [`crate::lanes`] (f32 lanes for the renderer's packet kernel), tested against the models
+//!   above.
 //!
 //! Opaque models are written for the upper hemisphere; [`crate::two_sided::TwoSided`] makes
 //! them two-sided.
@@ -19,6 +22,7 @@ pub mod glint;
 pub mod il;
 pub mod kelemen;
 pub mod lambert;
+pub mod lane_models;
 pub mod multiple_scattering;
 pub mod oren_nayar;
 pub mod rough_conductor;
@@ -27,6 +31,7 @@ pub mod rough_dielectric;
 pub use il::InterfacedLambertian;
 pub use kelemen::Kelemen;
 pub use lambert::Lambert;
+pub use lane_models::{LaneBsdf, LaneFresnel, LaneNdf, LaneSample};
 pub use multiple_scattering::{
     CompensatedConductor, CompensatedDielectric, MultipleScatteringConductor,
     MultipleScatteringDielectric,

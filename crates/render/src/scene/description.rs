@@ -123,6 +123,9 @@ pub struct IntegratorDesc {
     pub max_depth: u32,
     #[serde(default = "default_rr_depth")]
     pub rr_depth: u32,
+    /// `"scalar"` (default) or `"packet"`.
+    #[serde(default)]
+    pub kernel: Option<String>,
 }
 
 impl Default for IntegratorDesc {
@@ -130,6 +133,7 @@ impl Default for IntegratorDesc {
         IntegratorDesc {
             max_depth: default_max_depth(),
             rr_depth: default_rr_depth(),
+            kernel: None,
         }
     }
 }

@@ -41,6 +41,8 @@ pub struct FilmSettings {
 pub struct IntegratorSettings {
     pub max_depth: u32,
     pub rr_depth: u32,
+    /// The render kernel (`kernel = "scalar" | "packet"`).
+    pub kernel: crate::kernel::Kernel,
 }
 
 /// A loaded scene.

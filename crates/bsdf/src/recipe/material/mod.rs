@@ -26,6 +26,7 @@ use crate::math::spectrum::Spectrum;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Ndf;
 use crate::models::il::interfaced_lambertian::Scattering;
+use crate::models::lane_models::{LaneBsdf, LaneFresnel, LaneNdf};
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::Kelemen;
 use crate::two_sided::TwoSided;
@@ -130,6 +131,50 @@ pub enum MaterialRecipe {
 }
 
 impl MaterialRecipe {
+    /// The lane model of the recipe (`models::lane_models`: the renderer's packet kernel
+    /// evaluates it in f32 lanes), or `None` where the recipe needs its f64 model.
+    pub fn lane_model(&self) -> Option<LaneBsdf> {
+        let lobe_ndf = |lobe: &Option<crate::microfacet::specular_lobe::SpecularLobe>| {
+            let l = lobe.as_ref()?;
+            let plain = l.masking == crate::microfacet::Masking::SmithSeparable
+                && l.sampling() == crate::microfacet::specular_lobe::NormalSampling::Visible;
+            if plain {
+                LaneNdf::from_ndf(&l.ndf)
+            } else {
+                None
+            }
+        };
+        match self {
+            MaterialRecipe::Lambert { reflectance } => Some(LaneBsdf::Lambert {
+                reflectance: reflectance.0,
+            }),
+            MaterialRecipe::Conductor {
+                lobe,
+                fresnel,
+                tint,
+                energy: microfacet_models::MicrofacetEnergy::Single,
+            } => Some(LaneBsdf::Conductor {
+                ndf: lobe_ndf(lobe)?,
+                fresnel: LaneFresnel::from_fresnel(fresnel)?,
+                tint: tint.0,
+            }),
+            MaterialRecipe::Dielectric {
+                lobe,
+                eta,
+                widened: false,
+                reflect_tint,
+                transmit_tint,
+                energy: microfacet_models::MicrofacetEnergy::Single,
+            } => Some(LaneBsdf::Dielectric {
+                ndf: lobe_ndf(lobe)?,
+                eta: *eta,
+                reflect_tint: reflect_tint.0,
+                transmit_tint: transmit_tint.0,
+            }),
+            _ => None,
+        }
+    }
+
     /// Parses and validates a material table (without an image reader: a glint
     /// `normal_map` file is an error, see [`MaterialRecipe::parse_with_reader`]).
     pub fn parse(table: &toml::Table, base_dir: &std::path::Path) -> ParamResult<MaterialRecipe> {

@@ -2,6 +2,7 @@
 
 use super::context::Ctx;
 use crate::film::Filter;
+use crate::kernel::Kernel;
 use crate::sampler::SamplerKind;
 use crate::scene::description::{FilmDesc, IntegratorDesc};
 use crate::scene::{FilmSettings, IntegratorSettings, SceneError};
@@ -81,8 +82,21 @@ pub(super) fn create_integrator(
     if i.max_depth == 0 || i.max_depth > 1024 {
         return Err(ctx.err(integ_span, "`max_depth` must be in 1…1024"));
     }
+    let kernel = match i.kernel.as_deref() {
+        None => Kernel::default(),
+        Some(name) => Kernel::parse(name).ok_or_else(|| {
+            ctx.err(
+                integ_span,
+                format!(
+                    "unknown kernel `{name}`; valid kernels: {}",
+                    Kernel::NAMES.join(", ")
+                ),
+            )
+        })?,
+    };
     Ok(IntegratorSettings {
         max_depth: i.max_depth,
         rr_depth: i.rr_depth,
+        kernel,
     })
 }

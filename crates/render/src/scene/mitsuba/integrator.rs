@@ -18,6 +18,7 @@ pub(crate) fn default_integrator() -> IntegratorDesc {
     IntegratorDesc {
         max_depth: UNLIMITED_DEPTH,
         rr_depth: 5,
+        kernel: None,
     }
 }
 

@@ -1,0 +1,430 @@
+//! Eight f32 lanes as a plain array whose every operation is a loop of eight: inlined into a
+//! function compiled for AVX2 (`#[target_feature(enable = "avx2,fma")]`, chosen at run
+//! time by the renderer) each loop becomes one 256-bit instruction, and into the baseline
+//! x86-64 build two SSE instructions, so one portable binary carries both (no
+//! `-C target-cpu`, no nightly `std::simd`). The transcendental functions are branch-free
+//! Cephes polynomials (Moshier, *Cephes Math Library*, `sinf`/`cosf`/`expf`/`logf`),
+//! about 1 ulp on the ranges the models use, so that they vectorize too.
+
+use super::real::{Mask, Real};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// Eight f32 lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub struct F32x8(pub [f32; 8]);
+
+/// Eight lane booleans, all bits set or clear (the layout of an AVX compare).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C, align(32))]
+pub struct M32x8(pub [u32; 8]);
+
+/// Eight i32 lanes, for the exponent and quadrant arithmetic of the polynomials.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+struct I32x8([i32; 8]);
+
+macro_rules! lanewise {
+    ($a:expr, |$x:ident| $e:expr) => {{
+        let a = $a;
+        let mut r = [Default::default(); 8];
+        for i in 0..8 {
+            let $x = a[i];
+            r[i] = $e;
+        }
+        r
+    }};
+    ($a:expr, $b:expr, |$x:ident, $y:ident| $e:expr) => {{
+        let (a, b) = ($a, $b);
+        let mut r = [Default::default(); 8];
+        for i in 0..8 {
+            let ($x, $y) = (a[i], b[i]);
+            r[i] = $e;
+        }
+        r
+    }};
+}
+
+macro_rules! binop {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl $tr for F32x8 {
+            type Output = F32x8;
+            #[inline(always)]
+            fn $f(self, o: F32x8) -> F32x8 {
+                F32x8(lanewise!(self.0, o.0, |a, b| a $op b))
+            }
+        }
+    };
+}
+binop!(Add, add, +);
+binop!(Sub, sub, -);
+binop!(Mul, mul, *);
+binop!(Div, div, /);
+
+impl Neg for F32x8 {
+    type Output = F32x8;
+    #[inline(always)]
+    fn neg(self) -> F32x8 {
+        F32x8(lanewise!(self.0, |a| -a))
+    }
+}
+
+impl BitAnd for M32x8 {
+    type Output = M32x8;
+    #[inline(always)]
+    fn bitand(self, o: M32x8) -> M32x8 {
+        M32x8(lanewise!(self.0, o.0, |a, b| a & b))
+    }
+}
+impl BitOr for M32x8 {
+    type Output = M32x8;
+    #[inline(always)]
+    fn bitor(self, o: M32x8) -> M32x8 {
+        M32x8(lanewise!(self.0, o.0, |a, b| a | b))
+    }
+}
+impl Not for M32x8 {
+    type Output = M32x8;
+    #[inline(always)]
+    fn not(self) -> M32x8 {
+        M32x8(lanewise!(self.0, |a| !a))
+    }
+}
+
+impl M32x8 {
+    /// One bit per lane, lane 0 in bit 0 (AVX's `movemask`).
+    #[inline(always)]
+    pub fn bits(self) -> u32 {
+        let mut b = 0;
+        for i in 0..8 {
+            b |= (self.0[i] >> 31) << i;
+        }
+        b
+    }
+}
+
+impl Mask for M32x8 {
+    #[inline(always)]
+    fn splat(b: bool) -> Self {
+        M32x8([if b { !0 } else { 0 }; 8])
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.bits() != 0
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self.bits() == 0xFF
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> bool {
+        self.0[i] != 0
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
+        M32x8(std::array::from_fn(|i| if f(i) { !0 } else { 0 }))
+    }
+}
+
+#[inline(always)]
+fn cmp(a: F32x8, b: F32x8, f: impl Fn(f32, f32) -> bool) -> M32x8 {
+    M32x8(lanewise!(a.0, b.0, |x, y| if f(x, y) { !0u32 } else { 0 }))
+}
+
+/// 1.5 · 2²³: adding it rounds an f32 below 2²² to the nearest integer, which its low
+/// mantissa bits then hold (the branch-free rounding of vectorized libms).
+const ROUND_MAGIC: f32 = 12_582_912.0;
+
+impl F32x8 {
+    #[inline(always)]
+    fn bits(self) -> [u32; 8] {
+        lanewise!(self.0, |a| a.to_bits())
+    }
+    #[inline(always)]
+    fn from_bits(b: [u32; 8]) -> F32x8 {
+        F32x8(lanewise!(b, |a| f32::from_bits(a)))
+    }
+    /// (round(x) as f32, round(x) as i32) for |x| < 2²².
+    #[inline(always)]
+    fn round_with_int(self) -> (F32x8, I32x8) {
+        let shifted = self + F32x8::splat(ROUND_MAGIC as f64);
+        let r = shifted - F32x8::splat(ROUND_MAGIC as f64);
+        let n = lanewise!(shifted.bits(), |b| (b as i32)
+            .wrapping_sub(ROUND_MAGIC.to_bits() as i32));
+        (r, I32x8(n))
+    }
+}
+
+impl Real for F32x8 {
+    type Mask = M32x8;
+    const LANES: usize = 8;
+    const TINY: f64 = 1e-30;
+
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        F32x8([v as f32; 8])
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        self.0[i] as f64
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+        F32x8(std::array::from_fn(|i| f(i) as f32))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        F32x8(lanewise!(self.0, |a| a.sqrt()))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self::from_bits(lanewise!(self.bits(), |b| b & 0x7FFF_FFFF))
+    }
+    /// `self < o ? self : o` (the SSE/AVX `min` operand order: a NaN `self` yields `o`).
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        F32x8(lanewise!(self.0, o.0, |a, b| if a < b { a } else { b }))
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        F32x8(lanewise!(self.0, o.0, |a, b| if a > b { a } else { b }))
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M32x8 {
+        cmp(self, o, |a, b| a < b)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M32x8 {
+        cmp(self, o, |a, b| a <= b)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> M32x8 {
+        cmp(self, o, |a, b| a > b)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> M32x8 {
+        cmp(self, o, |a, b| a >= b)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M32x8 {
+        cmp(self, o, |a, b| a == b)
+    }
+    #[inline(always)]
+    fn select(m: M32x8, a: Self, b: Self) -> Self {
+        let (ab, bb) = (a.bits(), b.bits());
+        let mut r = [0u32; 8];
+        for i in 0..8 {
+            r[i] = (m.0[i] & ab[i]) | (!m.0[i] & bb[i]);
+        }
+        Self::from_bits(r)
+    }
+
+    /// Cephes `sinf`/`cosf`: the quadrant k = round(x·2/π), the remainder
+    /// z = |x| − kπ/2 in three parts, and the two minimax polynomials on [−π/4, π/4].
+    /// Accurate to about 1 ulp for |x| < 2¹³ (the models pass angles in [0, 2π]).
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let ax = self.abs();
+        let (k, ki) = (ax * F32x8::splat(std::f64::consts::FRAC_2_PI)).round_with_int();
+        let z = ((ax - k * F32x8::splat(1.570_312_5)) - k * F32x8::splat(4.837_512_969_970_703e-4))
+            - k * F32x8::splat(7.549_789_954_891_882e-8);
+        let zz = z * z;
+        let cos_p = ((F32x8::splat(2.443_315_711_809_948e-5) * zz
+            - F32x8::splat(1.388_731_625_493_765e-3))
+            * zz
+            + F32x8::splat(4.166_664_568_298_827e-2))
+            * zz
+            * zz
+            - F32x8::splat(0.5) * zz
+            + F32x8::one();
+        let sin_p = ((F32x8::splat(-1.951_529_589_1e-4) * zz + F32x8::splat(8.332_160_873_6e-3))
+            * zz
+            - F32x8::splat(1.666_665_461_1e-1))
+            * zz
+            * z
+            + z;
+        let swap = M32x8(lanewise!(ki.0, |q| if q & 1 != 0 { !0u32 } else { 0 }));
+        let s = Self::select(swap, cos_p, sin_p);
+        let c = Self::select(swap, sin_p, cos_p);
+        // Sign bits: sin is negative in quadrants 2 and 3 (and odd in x), cos in 1 and 2.
+        let neg = self.bits();
+        let mut sb = s.bits();
+        let mut cb = c.bits();
+        for i in 0..8 {
+            let q = ki.0[i] as u32;
+            sb[i] ^= ((q & 2) << 30) ^ (neg[i] & 0x8000_0000);
+            cb[i] ^= (q.wrapping_add(1) & 2) << 30;
+        }
+        (Self::from_bits(sb), Self::from_bits(cb))
+    }
+
+    /// Cephes `expf`: e^x = 2ⁿ e^r with n = round(x/ln 2), r in [−ln2/2, ln2/2], and a
+    /// degree-6 polynomial; x is clamped to [−87.3, 88.37] (the normal f32 range).
+    #[inline(always)]
+    fn exp(self) -> Self {
+        let x = self.clamp(-87.3, 88.37);
+        let (n, ni) = (x * F32x8::splat(std::f64::consts::LOG2_E)).round_with_int();
+        let r = x - n * F32x8::splat(0.693_359_375) - n * F32x8::splat(-2.121_944_4e-4);
+        let mut p = F32x8::splat(1.987_569_150_0e-4);
+        for c in [
+            1.398_199_950_7e-3,
+            8.333_451_907_3e-3,
+            4.166_579_589_4e-2,
+            1.666_666_545_9e-1,
+            5.000_000_120_1e-1,
+        ] {
+            p = p * r + F32x8::splat(c);
+        }
+        let y = p * r * r + r + F32x8::one();
+        let scale = Self::from_bits(lanewise!(ni.0, |e| ((e + 127) as u32) << 23));
+        let out = y * scale;
+        // A NaN input stays NaN (the clamp above would have turned it into a number).
+        Self::select(self.eq(self), out, self)
+    }
+
+    /// Cephes `logf`: x = m·2ᵉ with m in [√½, √2), ln x = e ln 2 + ln m by a degree-8
+    /// polynomial. ln 0 = −∞, ln of a negative or NaN is NaN, ln ∞ = ∞; subnormal inputs
+    /// are not handled (the models take logarithms of numbers ≥ 1e-30).
+    #[inline(always)]
+    fn ln(self) -> Self {
+        let b = self.bits();
+        let e = lanewise!(b, |v| ((v >> 23) & 0xFF) as i32 - 126);
+        let m = Self::from_bits(lanewise!(b, |v| (v & 0x807F_FFFF) | 0x3F00_0000));
+        // m in [0.5, 1): fold below √½ into [√½, √2) by doubling.
+        let small = m.lt(F32x8::splat(std::f64::consts::FRAC_1_SQRT_2));
+        let ef =
+            F32x8(lanewise!(e, |v| v as f32)) - Self::select(small, F32x8::one(), F32x8::zero());
+        let x = Self::select(small, m + m, m) - F32x8::one();
+        let z = x * x;
+        let mut y = F32x8::splat(7.037_683_629_2e-2);
+        for c in [
+            -1.151_461_031_0e-1,
+            1.167_699_874_0e-1,
+            -1.242_014_084_6e-1,
+            1.424_932_278_7e-1,
+            -1.666_805_766_5e-1,
+            2.000_071_476_5e-1,
+            -2.499_999_399_3e-1,
+            3.333_333_117_4e-1,
+        ] {
+            y = y * x + F32x8::splat(c);
+        }
+        let y = y * x * z + ef * F32x8::splat(-2.121_944_4e-4) - F32x8::splat(0.5) * z;
+        let out = x + y + ef * F32x8::splat(0.693_359_375);
+        let inf = F32x8::splat(f64::INFINITY);
+        let out = Self::select(self.eq(inf), inf, out);
+        let out = Self::select(self.eq(F32x8::zero()), -inf, out);
+        Self::select(self.ge(F32x8::zero()), out, F32x8::splat(f64::NAN))
+    }
+
+    #[inline(always)]
+    fn is_finite(self) -> M32x8 {
+        M32x8(lanewise!(
+            self.bits(),
+            |b| if b & 0x7F80_0000 != 0x7F80_0000 {
+                !0u32
+            } else {
+                0
+            }
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lanes(xs: &[f32]) -> Vec<F32x8> {
+        xs.chunks(8)
+            .map(|c| F32x8(std::array::from_fn(|i| c[i % c.len()])))
+            .collect()
+    }
+
+    /// Largest error in ulps of f32 against the f64 function, over `xs`.
+    fn max_ulps(xs: &[f32], f: impl Fn(F32x8) -> F32x8, g: impl Fn(f64) -> f64) -> f64 {
+        let mut worst: f64 = 0.0;
+        for v in lanes(xs) {
+            let r = f(v);
+            for i in 0..8 {
+                let want = g(v.0[i] as f64);
+                let got = r.0[i] as f64;
+                let ulp = (want.abs() as f32).max(f32::MIN_POSITIVE);
+                let ulp = (f32::from_bits(ulp.to_bits() + 1) - ulp) as f64;
+                worst = worst.max((got - want).abs() / ulp);
+            }
+        }
+        worst
+    }
+
+    fn grid(lo: f32, hi: f32, n: usize) -> Vec<f32> {
+        (0..n)
+            .map(|i| lo + (hi - lo) * i as f32 / (n - 1) as f32)
+            .collect()
+    }
+
+    #[test]
+    fn sin_cos_within_two_ulps_of_f64_on_the_models_range() {
+        let xs = grid(-7.0, 7.0, 200_001);
+        // Near zeros of sin/cos the absolute error matters, not the ulps of a tiny value.
+        let abs_err = |f: fn(F32x8) -> F32x8, g: fn(f64) -> f64| {
+            let mut worst: f64 = 0.0;
+            for v in lanes(&xs) {
+                let r = f(v);
+                for i in 0..8 {
+                    worst = worst.max((r.0[i] as f64 - g(v.0[i] as f64)).abs());
+                }
+            }
+            worst
+        };
+        let s = abs_err(|v| v.sin_cos().0, f64::sin);
+        let c = abs_err(|v| v.sin_cos().1, f64::cos);
+        assert!(s < 1.2e-7 && c < 1.2e-7, "sin {s:e}, cos {c:e}");
+        let xs = grid(0.05, 1.5, 10_001);
+        assert!(max_ulps(&xs, |v| v.sin_cos().0, f64::sin) <= 2.0);
+        assert!(max_ulps(&xs, |v| v.sin_cos().1, f64::cos) <= 2.0);
+    }
+
+    #[test]
+    fn exp_and_ln_within_two_ulps_of_f64() {
+        let xs = grid(-80.0, 80.0, 100_001);
+        let e = max_ulps(&xs, Real::exp, f64::exp);
+        assert!(e <= 2.0, "exp: {e} ulps");
+        let mut pos = grid(1e-6, 10.0, 100_001);
+        pos.extend(grid(10.0, 1e30, 10_001));
+        let l = max_ulps(&pos, Real::ln, f64::ln);
+        assert!(l <= 2.0, "ln: {l} ulps");
+        let special = F32x8([0.0, -1.0, f32::INFINITY, f32::NAN, 1.0, 0.5, 2.0, 1e-30]);
+        let r = special.ln().0;
+        assert_eq!(r[0], f32::NEG_INFINITY);
+        assert!(r[1].is_nan() && r[3].is_nan());
+        assert_eq!(r[2], f32::INFINITY);
+        assert_eq!(r[4], 0.0);
+        assert!(F32x8::splat(f64::NAN).exp().0[0].is_nan());
+        assert_eq!(F32x8::splat(-1000.0).exp().0[0] < 1e-37, true);
+    }
+
+    #[test]
+    fn masks_select_and_compare_lane_by_lane() {
+        let a = F32x8([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        let b = F32x8::splat(3.5);
+        let m = a.lt(b);
+        assert_eq!(m.bits(), 0b0000_1111);
+        assert!(m.any() && !m.all() && !(m & !m).any() && (m | !m).all());
+        let s = F32x8::select(m, a, b);
+        assert_eq!(s.0, [0.0, 1.0, 2.0, 3.0, 3.5, 3.5, 3.5, 3.5]);
+        assert_eq!((-a).abs(), a);
+        assert_eq!(a.min(b).0[5], 3.5);
+        assert_eq!(a.max(b).0[5], 5.0);
+        let inf = F32x8([
+            1.0,
+            f32::INFINITY,
+            f32::NAN,
+            -f32::INFINITY,
+            0.0,
+            1e38,
+            -1e-38,
+            2.0,
+        ]);
+        assert_eq!(inf.is_finite().bits(), 0b1111_0001);
+    }
+}

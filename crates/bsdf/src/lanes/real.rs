@@ -1,0 +1,209 @@
+//! The lane trait: the number type the microfacet core and the vectorized models are
+//! written over once. `f64` is the lab's instantiation (validation, `eval`, `albedo`, `fit`,
+//! Python), `f32` a scalar renderer lane, and [`F32x8`](super::F32x8) eight renderer paths
+//! at a time. A choice between two values is written as both values and a
+//! [`select`](Real::select) on a mask, so the same source serves one lane and eight; an
+//! expensive branch is guarded by [`Mask::any`], which is a plain `if` for one lane.
+
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// A lane-wise boolean: `bool` for one lane, a bit mask for several.
+pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> {
+    fn splat(b: bool) -> Self;
+    /// Whether some lane is set.
+    fn any(self) -> bool;
+    /// Whether every lane is set.
+    fn all(self) -> bool;
+    /// Whether no lane is set.
+    #[inline(always)]
+    fn none(self) -> bool {
+        !self.any()
+    }
+    fn lane(self, i: usize) -> bool;
+    fn from_fn(f: impl FnMut(usize) -> bool) -> Self;
+}
+
+impl Mask for bool {
+    #[inline(always)]
+    fn splat(b: bool) -> Self {
+        b
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn lane(self, _: usize) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
+        f(0)
+    }
+}
+
+/// A real number per lane.
+pub trait Real:
+    Copy
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    type Mask: Mask;
+    /// Lanes per value.
+    const LANES: usize;
+    /// The smallest value a guard against underflow may use: 1e-300 in f64, 1e-30 in f32.
+    const TINY: f64;
+
+    fn splat(v: f64) -> Self;
+    /// Lane `i` as f64.
+    fn lane(self, i: usize) -> f64;
+    fn from_fn(f: impl FnMut(usize) -> f64) -> Self;
+
+    fn sqrt(self) -> Self;
+    fn abs(self) -> Self;
+    fn min(self, o: Self) -> Self;
+    fn max(self, o: Self) -> Self;
+    fn lt(self, o: Self) -> Self::Mask;
+    fn le(self, o: Self) -> Self::Mask;
+    fn gt(self, o: Self) -> Self::Mask;
+    fn ge(self, o: Self) -> Self::Mask;
+    fn eq(self, o: Self) -> Self::Mask;
+    /// Lane-wise `if m { a } else { b }`.
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    fn sin_cos(self) -> (Self, Self);
+    fn exp(self) -> Self;
+    fn ln(self) -> Self;
+    /// Whether each lane is neither infinite nor NaN.
+    fn is_finite(self) -> Self::Mask;
+
+    /// A scalar function applied lane by lane: the fallback for what does not vectorize
+    /// (table lookups, the Beckmann visible-slope inversion).
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        Self::from_fn(|i| f(self.lane(i)))
+    }
+    #[inline(always)]
+    fn zero() -> Self {
+        Self::splat(0.0)
+    }
+    #[inline(always)]
+    fn one() -> Self {
+        Self::splat(1.0)
+    }
+    /// `a` where `m`, else zero.
+    #[inline(always)]
+    fn masked(m: Self::Mask, a: Self) -> Self {
+        Self::select(m, a, Self::zero())
+    }
+    /// 1 with the sign of `self` (+1 for ±0).
+    #[inline(always)]
+    fn sign_or_one(self) -> Self {
+        Self::select(self.lt(Self::zero()), -Self::one(), Self::one())
+    }
+    /// Clamped to [lo, hi].
+    #[inline(always)]
+    fn clamp(self, lo: f64, hi: f64) -> Self {
+        self.max(Self::splat(lo)).min(Self::splat(hi))
+    }
+}
+
+macro_rules! scalar_real {
+    ($t:ty, $tiny:expr) => {
+        impl Real for $t {
+            type Mask = bool;
+            const LANES: usize = 1;
+            const TINY: f64 = $tiny;
+            #[inline(always)]
+            fn splat(v: f64) -> Self {
+                v as $t
+            }
+            #[inline(always)]
+            fn lane(self, _: usize) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+                f(0) as $t
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                <$t>::abs(self)
+            }
+            #[inline(always)]
+            fn min(self, o: Self) -> Self {
+                <$t>::min(self, o)
+            }
+            #[inline(always)]
+            fn max(self, o: Self) -> Self {
+                <$t>::max(self, o)
+            }
+            #[inline(always)]
+            fn lt(self, o: Self) -> bool {
+                self < o
+            }
+            #[inline(always)]
+            fn le(self, o: Self) -> bool {
+                self <= o
+            }
+            #[inline(always)]
+            fn gt(self, o: Self) -> bool {
+                self > o
+            }
+            #[inline(always)]
+            fn ge(self, o: Self) -> bool {
+                self >= o
+            }
+            #[inline(always)]
+            fn eq(self, o: Self) -> bool {
+                self == o
+            }
+            #[inline(always)]
+            fn select(m: bool, a: Self, b: Self) -> Self {
+                if m {
+                    a
+                } else {
+                    b
+                }
+            }
+            #[inline(always)]
+            fn sin_cos(self) -> (Self, Self) {
+                <$t>::sin_cos(self)
+            }
+            #[inline(always)]
+            fn exp(self) -> Self {
+                <$t>::exp(self)
+            }
+            #[inline(always)]
+            fn ln(self) -> Self {
+                <$t>::ln(self)
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+            /// The native clamp, which keeps a NaN a NaN (the strict finite guard then
+            /// names the model that made it).
+            #[inline(always)]
+            fn clamp(self, lo: f64, hi: f64) -> Self {
+                <$t>::clamp(self, lo as $t, hi as $t)
+            }
+        }
+    };
+}
+
+scalar_real!(f64, 1e-300);
+scalar_real!(f32, 1e-30);
