@@ -35,6 +35,7 @@ fn _facette(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parts::render_in_parts, m)?)?;
     m.add_function(wrap_pyfunction!(parts::merge_render_parts, m)?)?;
     m.add_function(wrap_pyfunction!(parts::tabulate, m)?)?;
+    m.add_function(wrap_pyfunction!(parts::check_table_material, m)?)?;
     m.add_function(wrap_pyfunction!(parts::tabulate_part, m)?)?;
     m.add_function(wrap_pyfunction!(parts::merge_table_parts, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;

@@ -159,6 +159,13 @@ fn il_lobe(
     })
 }
 
+/// Checks that `material` can be tabulated (a rough IL material): the driver-side check
+/// of a distributed table.
+#[pyfunction]
+pub fn check_table_material(material: &Bound<'_, PyAny>) -> PyResult<()> {
+    il_lobe(material).map(|_| ())
+}
+
 /// Tabulates the body term of an IL material (`facette tabulate`); returns the `.fctab`
 /// bytes and writes them to `output` when given.
 #[pyfunction]

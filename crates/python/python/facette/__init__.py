@@ -298,6 +298,8 @@ def _scene(scene):
     if not isinstance(scene, str):
         raise TypeError(f"`scene` must be a path, TOML or XML text, or a dict, got {type(scene).__name__}")
     text = scene.strip()
+    if "\n" not in text and _os.path.isfile(text):
+        return "path", scene
     if text.startswith("<"):
         return "xml", scene
     if "\n" in text or "=" in text or text.startswith("["):
