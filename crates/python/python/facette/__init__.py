@@ -79,6 +79,8 @@ def _count(value, name, minimum=0, optional=False):
     value = int(value)
     if value < minimum:
         raise ValueError(f"`{name}` = {value}: must be at least {minimum}")
+    if value >= 2**64:
+        raise ValueError(f"`{name}` = {value}: must be below 2**64")
     return value
 
 
