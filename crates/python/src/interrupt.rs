@@ -162,6 +162,25 @@ pub fn run<T: Send + 'static>(
     Ok(outcome)
 }
 
+/// [`run_all`], or for `small` work without a progress callback, the work itself on this
+/// thread with the GIL released: a call on a few rows (a Python loop over directions)
+/// should not pay for a thread, and is over before a Ctrl-C would matter.
+pub fn run_small_or_all<T: Send + 'static>(
+    py: Python<'_>,
+    call: &'static str,
+    progress: Option<Py<PyAny>>,
+    small: bool,
+    work: impl FnOnce(&Control) -> T + Send + 'static,
+) -> PyResult<T> {
+    if small && progress.is_none() {
+        return py.detach(|| {
+            catch_unwind(AssertUnwindSafe(|| work(&Control::default())))
+                .map_err(|p| panic_error(call, p.as_ref()))
+        });
+    }
+    run_all(py, call, progress, work)
+}
+
 /// [`run`] for work whose partial result is of no use: an interruption is an error.
 pub fn run_all<T: Send + 'static>(
     py: Python<'_>,

@@ -2,7 +2,7 @@
 
 use crate::arrays::directions;
 use crate::errors::value_error;
-use crate::interrupt::{guard, run_all, Control};
+use crate::interrupt::{guard, run_all, run_small_or_all, Control};
 use crate::toml_value::{inline_toml, table_from_py, table_to_py};
 use facette_bsdf::math::rng::{mix_seed, Pcg32, RandomSource};
 use facette_bsdf::math::spherical_direction;
@@ -71,15 +71,26 @@ impl Material {
     }
 }
 
-/// A thread pool of `threads` threads (all cores when None).
-fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
-    if threads == Some(0) {
-        return Err(value_error("`threads` must be at least 1"));
+/// A thread pool of `threads` threads; None (all cores) is rayon's global pool, started
+/// once per process rather than per call.
+fn pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
+    match threads {
+        None => Ok(None),
+        Some(0) => Err(value_error("`threads` must be at least 1")),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map(Some)
+            .map_err(|e| value_error(format!("cannot start the thread pool: {e}"))),
     }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| value_error(format!("cannot start the thread pool: {e}")))
+}
+
+/// `f` in `pool`, or in the global pool.
+fn install<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
+    match pool {
+        Some(p) => p.install(f),
+        None => f(),
+    }
 }
 
 /// Rows per parallel chunk: large enough that scheduling costs nothing, small enough that
@@ -89,14 +100,14 @@ const CHUNK: usize = 256;
 /// `f(k)` for every k < n, in chunks on `pool`, stopping (rows left at their default)
 /// when cancelled.
 fn par_rows<T: Send + Default + Clone>(
-    pool: &rayon::ThreadPool,
+    pool: &Option<rayon::ThreadPool>,
     c: &Control,
     n: usize,
     f: impl Fn(usize) -> T + Sync,
 ) -> Vec<T> {
     c.set_total(n as u64);
     let mut out = vec![T::default(); n];
-    pool.install(|| {
+    install(pool, || {
         out.par_chunks_mut(CHUNK)
             .enumerate()
             .for_each(|(j, chunk)| {
@@ -197,7 +208,15 @@ impl Material {
         }
         let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
-        let rows = run_all(py, "facette.Material.eval", progress, move |c| {
+        // A stochastic row costs `samples` evaluations.
+        let work = wi.len()
+            * if self.bsdf.is_stochastic() {
+                samples
+            } else {
+                1
+            };
+        let small = work <= CHUNK;
+        let rows = run_small_or_all(py, "facette.Material.eval", progress, small, move |c| {
             if bsdf.is_stochastic() {
                 // One stream through the rows, in order: `facette eval`'s values.
                 c.set_total(wi.len() as u64);
@@ -252,7 +271,8 @@ impl Material {
         }
         let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
-        let out = run_all(py, "facette.Material.pdf", None, move |c| {
+        let small = wi.len() <= CHUNK;
+        let out = run_small_or_all(py, "facette.Material.pdf", None, small, move |c| {
             par_rows(&pool, c, wi.len(), |k| bsdf.pdf(wo[k], wi[k], &ctx))
         })?;
         Ok(Array1::from_vec(out).into_pyarray(py))
@@ -301,25 +321,27 @@ impl Material {
         let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
         type Row = ([f64; 3], [f64; 3], f64, String);
-        let rows: Vec<Row> = run_all(py, "facette.Material.sample", None, move |c| {
-            par_rows(&pool, c, wo.len(), |k| {
-                let row: Vec<f64> = u.as_ref().map(|a| a.row(k).to_vec()).unwrap_or_default();
-                let mut rng = ReplayRandom {
-                    given: &row,
-                    next: 0,
-                    rest: Pcg32::new(mix_seed(seed, k as u64), 0),
-                };
-                match bsdf.sample(wo[k], &ctx, &mut rng) {
-                    Some(s) => (
-                        [s.wi[0], s.wi[1], s.wi[2]],
-                        [s.weight[0], s.weight[1], s.weight[2]],
-                        s.pdf,
-                        s.lobe.describe(),
-                    ),
-                    None => ([0.0; 3], [0.0; 3], 0.0, "none".to_string()),
-                }
-            })
-        })?;
+        let small = wo.len() <= CHUNK;
+        let rows: Vec<Row> =
+            run_small_or_all(py, "facette.Material.sample", None, small, move |c| {
+                par_rows(&pool, c, wo.len(), |k| {
+                    let row: Vec<f64> = u.as_ref().map(|a| a.row(k).to_vec()).unwrap_or_default();
+                    let mut rng = ReplayRandom {
+                        given: &row,
+                        next: 0,
+                        rest: Pcg32::new(mix_seed(seed, k as u64), 0),
+                    };
+                    match bsdf.sample(wo[k], &ctx, &mut rng) {
+                        Some(s) => (
+                            [s.wi[0], s.wi[1], s.wi[2]],
+                            [s.weight[0], s.weight[1], s.weight[2]],
+                            s.pdf,
+                            s.lobe.describe(),
+                        ),
+                        None => ([0.0; 3], [0.0; 3], 0.0, "none".to_string()),
+                    }
+                })
+            })?;
         let n = rows.len();
         let mut wis = Array2::<f64>::zeros((n, 3));
         let mut weights = Array2::<f64>::zeros((n, 3));
@@ -369,7 +391,7 @@ impl Material {
         let bsdf = self.bsdf.clone();
         let rows = run_all(py, "facette.Material.albedo", progress, move |c| {
             c.set_total(theta_i.len() as u64);
-            pool.install(|| {
+            install(&pool, || {
                 theta_i
                     .par_iter()
                     .map(|t| {

@@ -97,7 +97,7 @@ impl SceneArg {
                 film.insert(key.into(), toml::Value::Integer(v as i64));
             }
         }
-        Ok(toml::to_string(&t).map_err(value_error)?)
+        toml::to_string(&t).map_err(value_error)
     }
 
     /// Loads the scene (the file, with its assets relative to its folder; text, with its

@@ -80,7 +80,8 @@ fn to_value(v: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
     // numpy arrays and scalars: `tolist()` gives lists of Python numbers (a scalar gives
     // the number itself), whatever the dtype and memory layout.
     let type_name = v.get_type().name()?.to_string();
-    if v.get_type().module()?.to_string() == "numpy" {
+    let module: String = v.get_type().module()?.extract()?;
+    if module == "numpy" {
         if let Ok(l) = v.call_method0("tolist") {
             return to_value(&l, path);
         }
