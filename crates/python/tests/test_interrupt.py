@@ -23,8 +23,9 @@ REPO = pathlib.Path(__file__).resolve().parents[3]
 CHILD = r"""
 import sys, time, numpy as np, facette
 what = sys.argv[1]
-print("ready", flush=True)
 try:
+    # Inside the try: a signal that lands right after this line is still caught below.
+    print("ready", flush=True)
     if what == "render":
         facette.render("scenes/bench-sphere.toml", spp=64, threads=1)
     elif what == "validate":
