@@ -2,6 +2,7 @@
 //! a material as a MERL file — the `facette fit` and `facette measure` commands.
 
 use crate::errors::{os_error, value_error};
+use crate::interrupt::run_all;
 use crate::material::Material;
 use facette_lab::fit::slices::fit_slices;
 use facette_lab::fit::FitOptions;
@@ -26,7 +27,8 @@ fn merl_error(e: MerlError) -> PyErr {
 /// writes the measured-vs-fitted slices at θ_i = 30° and 70° (.svg or .png).
 #[pyfunction]
 #[pyo3(signature = (path, model = "il", distribution = "beckmann", il_evaluation = "quadrature",
-    il_samples = 128, error = "log", samples = 4000, max_theta = 80.0, seed = 1, output = None))]
+    il_samples = 128, error = "log", samples = 4000, max_theta = 80.0, seed = 1, output = None,
+    progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -40,6 +42,7 @@ pub fn fit<'py>(
     max_theta: f64,
     seed: u64,
     output: Option<PathBuf>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = FitOptions {
         model: model.into(),
@@ -57,7 +60,9 @@ pub fn fit<'py>(
     if let Some(o) = &output {
         Format::of(o).map_err(value_error)?;
     }
-    let fitted = py.detach(|| -> PyResult<_> {
+    // The fit reports no progress of its own: `progress` sees (0, 1) until it ends.
+    let fitted = run_all(py, "facette.fit", progress, move |c| -> PyResult<_> {
+        c.set_total(1);
         let merl = MerlBrdf::load(&path).map_err(merl_error)?;
         let fitted = options
             .fit(&merl)
@@ -77,8 +82,9 @@ pub fn fit<'py>(
             .map_err(value_error)?;
             save_figure(&fig, o).map_err(os_error)?;
         }
+        c.advance(1);
         Ok(fitted)
-    })?;
+    })??;
     let r = &fitted.report;
     let d = PyDict::new(py);
     let parameters = PyDict::new(py);
@@ -119,9 +125,9 @@ pub fn measure(
         )));
     }
     let bsdf = material.bsdf();
-    py.detach(move || {
+    run_all(py, "facette.measure", None, move |_| {
         let merl = measure_material(bsdf.as_ref(), noise, seed);
         merl.save(&path).map_err(merl_error)?;
         Ok(merl.valid_bins())
-    })
+    })?
 }

@@ -2,10 +2,13 @@
 
 use crate::arrays::directions;
 use crate::errors::value_error;
-use crate::toml_value::table_from_py;
+use crate::interrupt::{guard, run_all, run_small_or_all, Control};
+use crate::toml_value::{inline_toml, table_from_py, table_to_py};
 use facette_bsdf::math::rng::{mix_seed, Pcg32, RandomSource};
 use facette_bsdf::math::spherical_direction;
-use facette_bsdf::validation::bsdf_checks::{check_bsdf, directional_albedo, BsdfCheckOptions};
+use facette_bsdf::validation::bsdf_checks::{
+    check_bsdf_watched, directional_albedo, BsdfCheckOptions,
+};
 use facette_bsdf::validation::chi2::Chi2Config;
 use facette_bsdf::validation::Report;
 use facette_bsdf::{Bsdf, BsdfContext, TransportMode};
@@ -13,6 +16,7 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 fn context(mode: &str) -> PyResult<BsdfContext> {
@@ -51,6 +55,8 @@ impl RandomSource for ReplayRandom<'_> {
 #[pyclass(frozen, module = "facette._facette")]
 pub struct Material {
     bsdf: Arc<dyn Bsdf>,
+    /// The spec it was built from: its identity (`==`, pickling, `.spec`).
+    table: toml::Table,
 }
 
 impl Material {
@@ -58,6 +64,63 @@ impl Material {
     pub(crate) fn bsdf(&self) -> Arc<dyn Bsdf> {
         self.bsdf.clone()
     }
+
+    /// The spec it was built from.
+    pub(crate) fn table(&self) -> &toml::Table {
+        &self.table
+    }
+}
+
+/// A thread pool of `threads` threads; None (all cores) is rayon's global pool, started
+/// once per process rather than per call.
+fn pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
+    match threads {
+        None => Ok(None),
+        Some(0) => Err(value_error("`threads` must be at least 1")),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map(Some)
+            .map_err(|e| value_error(format!("cannot start the thread pool: {e}"))),
+    }
+}
+
+/// `f` in `pool`, or in the global pool.
+fn install<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
+    match pool {
+        Some(p) => p.install(f),
+        None => f(),
+    }
+}
+
+/// Rows per parallel chunk: large enough that scheduling costs nothing, small enough that
+/// a cancel is seen quickly and the cores share the work.
+const CHUNK: usize = 256;
+
+/// `f(k)` for every k < n, in chunks on `pool`, stopping (rows left at their default)
+/// when cancelled.
+fn par_rows<T: Send + Default + Clone>(
+    pool: &Option<rayon::ThreadPool>,
+    c: &Control,
+    n: usize,
+    f: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
+    c.set_total(n as u64);
+    let mut out = vec![T::default(); n];
+    install(pool, || {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(j, chunk)| {
+                if c.cancelled() {
+                    return;
+                }
+                for (i, o) in chunk.iter_mut().enumerate() {
+                    *o = f(j * CHUNK + i);
+                }
+                c.advance(chunk.len() as u64);
+            })
+    });
+    out
 }
 
 #[pymethods]
@@ -65,8 +128,10 @@ impl Material {
     #[new]
     fn new(spec: &Bound<'_, PyAny>) -> PyResult<Self> {
         let table = table_from_py(spec)?;
-        let bsdf = facette_bsdf::recipe::build_material(&table).map_err(value_error)?;
-        Ok(Material { bsdf })
+        let bsdf = guard("facette.Material", || {
+            facette_bsdf::recipe::build_material(&table).map_err(value_error)
+        })?;
+        Ok(Material { bsdf, table })
     }
 
     /// The model and its parameters.
@@ -81,6 +146,31 @@ impl Material {
         self.bsdf.is_stochastic()
     }
 
+    /// The spec as a dict (TOML types: str, int, float, bool, list, dict).
+    #[getter]
+    fn spec<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        table_to_py(py, &self.table)
+    }
+
+    /// The spec as a TOML inline table, as the command line's `--material` takes it.
+    #[getter]
+    fn toml(&self) -> String {
+        inline_toml(&self.table)
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<Material>()
+            .is_ok_and(|o| o.get().table == self.table)
+    }
+
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        inline_toml(&self.table).hash(&mut h);
+        h.finish()
+    }
+
     fn __repr__(&self) -> String {
         format!("Material({})", self.bsdf.describe())
     }
@@ -88,8 +178,11 @@ impl Material {
     /// f(wi, wo) without the cosine, per RGB channel, for rows of `wi` (toward the light)
     /// and `wo` (toward the viewer), both (N, 3) in the local frame (z = normal). Stochastic
     /// materials average `samples` estimates per row from one stream seeded by `seed` —
-    /// the values `facette eval` prints for the same rows, seed and samples.
-    #[pyo3(signature = (wi, wo, samples = 100_000, mode = "radiance", seed = 1))]
+    /// the values `facette eval` prints for the same rows, seed and samples — and so run on
+    /// one thread; the others run on `threads` threads (all cores when None).
+    #[pyo3(signature = (wi, wo, samples = 100_000, mode = "radiance", seed = 1, threads = None,
+        progress = None))]
+    #[allow(clippy::too_many_arguments)]
     fn eval<'py>(
         &self,
         py: Python<'py>,
@@ -98,6 +191,8 @@ impl Material {
         samples: usize,
         mode: &str,
         seed: u64,
+        threads: Option<usize>,
+        progress: Option<Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let ctx = context(mode)?;
         let (wi, wo) = (directions(&wi, "wi")?, directions(&wo, "wo")?);
@@ -111,29 +206,59 @@ impl Material {
         if samples == 0 {
             return Err(value_error("`samples` must be at least 1"));
         }
+        let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
-        let out = py.detach(move || {
-            let mut rng = Pcg32::new(seed, 0);
-            let mut out = Array2::<f64>::zeros((wi.len(), 3));
-            for k in 0..wi.len() {
-                let (f, _) = bsdf.eval_estimate(wo[k], wi[k], &ctx, samples, &mut rng);
-                for c in 0..3 {
-                    out[[k, c]] = f[c];
+        // A stochastic row costs `samples` evaluations.
+        let work = wi.len()
+            * if self.bsdf.is_stochastic() {
+                samples
+            } else {
+                1
+            };
+        let small = work <= CHUNK;
+        let rows = run_small_or_all(py, "facette.Material.eval", progress, small, move |c| {
+            if bsdf.is_stochastic() {
+                // One stream through the rows, in order: `facette eval`'s values.
+                c.set_total(wi.len() as u64);
+                let mut rng = Pcg32::new(seed, 0);
+                let mut out = vec![[0.0; 3]; wi.len()];
+                for k in 0..wi.len() {
+                    if c.cancelled() {
+                        break;
+                    }
+                    let (f, _) = bsdf.eval_estimate(wo[k], wi[k], &ctx, samples, &mut rng);
+                    out[k] = [f[0], f[1], f[2]];
+                    c.advance(1);
                 }
+                out
+            } else {
+                par_rows(&pool, c, wi.len(), |k| {
+                    // Deterministic: the generator is not drawn from.
+                    let mut rng = Pcg32::new(seed, k as u64);
+                    let f = bsdf.eval(wo[k], wi[k], &ctx, &mut rng);
+                    [f[0], f[1], f[2]]
+                })
             }
-            out
-        });
+        })?;
+        let mut out = Array2::<f64>::zeros((rows.len(), 3));
+        for (k, f) in rows.iter().enumerate() {
+            for c in 0..3 {
+                out[[k, c]] = f[c];
+            }
+        }
         Ok(out.into_pyarray(py))
     }
 
     /// Solid-angle density with which `sample(wo)` draws `wi` (non-delta lobes), shape (N,).
-    #[pyo3(signature = (wo, wi, mode = "radiance"))]
+    /// Arguments in `eval`'s order: `wi` first.
+    #[pyo3(signature = (wi, wo, mode = "radiance", threads = None))]
     fn pdf<'py>(
         &self,
         py: Python<'py>,
-        wo: PyReadonlyArray2<'py, f64>,
         wi: PyReadonlyArray2<'py, f64>,
+        wo: PyReadonlyArray2<'py, f64>,
         mode: &str,
+        threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let ctx = context(mode)?;
         let (wi, wo) = (directions(&wi, "wi")?, directions(&wo, "wo")?);
@@ -144,18 +269,21 @@ impl Material {
                 wo.len()
             )));
         }
+        let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
-        let out = py
-            .detach(move || Array1::from_iter((0..wi.len()).map(|k| bsdf.pdf(wo[k], wi[k], &ctx))));
-        Ok(out.into_pyarray(py))
+        let small = wi.len() <= CHUNK;
+        let out = run_small_or_all(py, "facette.Material.pdf", None, small, move |c| {
+            par_rows(&pool, c, wi.len(), |k| bsdf.pdf(wo[k], wi[k], &ctx))
+        })?;
+        Ok(Array1::from_vec(out).into_pyarray(py))
     }
 
     /// Draws a direction per row of `wo`: returns (wi (N, 3), weight = f·|cos θ_i|/pdf
     /// (N, 3), pdf (N,), lobe names (list)). `u`, when given, is an (N, K) array of uniform
     /// numbers in [0, 1) consumed in order by row k's sampler (a stream seeded by `seed`
     /// and k continues when a row needs more than K); a failed sample has weight 0, pdf 0
-    /// and lobe "none".
-    #[pyo3(signature = (wo, u = None, mode = "radiance", seed = 1))]
+    /// and lobe "none". Rows are independent: `threads` does not change the result.
+    #[pyo3(signature = (wo, u = None, mode = "radiance", seed = 1, threads = None))]
     #[allow(clippy::type_complexity)]
     fn sample<'py>(
         &self,
@@ -164,6 +292,7 @@ impl Material {
         u: Option<PyReadonlyArray2<'py, f64>>,
         mode: &str,
         seed: u64,
+        threads: Option<usize>,
     ) -> PyResult<(
         Bound<'py, PyArray2<f64>>,
         Bound<'py, PyArray2<f64>>,
@@ -189,34 +318,43 @@ impl Material {
                 Some(v.to_owned())
             }
         };
+        let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
-        let (wis, weights, pdfs, lobes) = py.detach(move || {
-            let n = wo.len();
-            let mut wis = Array2::<f64>::zeros((n, 3));
-            let mut weights = Array2::<f64>::zeros((n, 3));
-            let mut pdfs = Array1::<f64>::zeros(n);
-            let mut lobes = Vec::with_capacity(n);
-            for k in 0..n {
-                let row: Vec<f64> = u.as_ref().map(|a| a.row(k).to_vec()).unwrap_or_default();
-                let mut rng = ReplayRandom {
-                    given: &row,
-                    next: 0,
-                    rest: Pcg32::new(mix_seed(seed, k as u64), 0),
-                };
-                match bsdf.sample(wo[k], &ctx, &mut rng) {
-                    Some(s) => {
-                        for c in 0..3 {
-                            wis[[k, c]] = s.wi[c];
-                            weights[[k, c]] = s.weight[c];
-                        }
-                        pdfs[k] = s.pdf;
-                        lobes.push(s.lobe.describe());
+        type Row = ([f64; 3], [f64; 3], f64, String);
+        let small = wo.len() <= CHUNK;
+        let rows: Vec<Row> =
+            run_small_or_all(py, "facette.Material.sample", None, small, move |c| {
+                par_rows(&pool, c, wo.len(), |k| {
+                    let row: Vec<f64> = u.as_ref().map(|a| a.row(k).to_vec()).unwrap_or_default();
+                    let mut rng = ReplayRandom {
+                        given: &row,
+                        next: 0,
+                        rest: Pcg32::new(mix_seed(seed, k as u64), 0),
+                    };
+                    match bsdf.sample(wo[k], &ctx, &mut rng) {
+                        Some(s) => (
+                            [s.wi[0], s.wi[1], s.wi[2]],
+                            [s.weight[0], s.weight[1], s.weight[2]],
+                            s.pdf,
+                            s.lobe.describe(),
+                        ),
+                        None => ([0.0; 3], [0.0; 3], 0.0, "none".to_string()),
                     }
-                    None => lobes.push("none".to_string()),
-                }
+                })
+            })?;
+        let n = rows.len();
+        let mut wis = Array2::<f64>::zeros((n, 3));
+        let mut weights = Array2::<f64>::zeros((n, 3));
+        let mut pdfs = Array1::<f64>::zeros(n);
+        let mut lobes = Vec::with_capacity(n);
+        for (k, (wi, w, p, lobe)) in rows.into_iter().enumerate() {
+            for c in 0..3 {
+                wis[[k, c]] = wi[c];
+                weights[[k, c]] = w[c];
             }
-            (wis, weights, pdfs, lobes)
-        });
+            pdfs[k] = p;
+            lobes.push(lobe);
+        }
         Ok((
             wis.into_pyarray(py),
             weights.into_pyarray(py),
@@ -227,14 +365,17 @@ impl Material {
 
     /// Directional reflectance and transmittance for incidence angles `theta_i` (degrees,
     /// a list; 0–90 from above, 90–180 from below), with standard errors — the numbers of
-    /// `facette albedo`. Returns a dict of (K, 3) arrays.
-    #[pyo3(signature = (theta_i, samples = 1_000_000, seed = 1))]
+    /// `facette albedo`. Returns a dict of (K, 3) arrays. The angles run in parallel on
+    /// `threads` threads (each angle has its own seeded stream: threads change nothing).
+    #[pyo3(signature = (theta_i, samples = 1_000_000, seed = 1, threads = None, progress = None))]
     fn albedo<'py>(
         &self,
         py: Python<'py>,
         theta_i: Vec<f64>,
         samples: usize,
         seed: u64,
+        threads: Option<usize>,
+        progress: Option<Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if samples < 100 {
             return Err(value_error("`samples` must be at least 100"));
@@ -246,16 +387,28 @@ impl Material {
                 )));
             }
         }
+        let pool = pool(threads)?;
         let bsdf = self.bsdf.clone();
-        let rows = py.detach(move || {
-            theta_i
-                .iter()
-                .map(|t| {
-                    let wi = spherical_direction(t.to_radians(), 0.0);
-                    directional_albedo(bsdf.as_ref(), wi, &BsdfContext::IMPORTANCE, samples, seed)
-                })
-                .collect::<Vec<_>>()
-        });
+        let rows = run_all(py, "facette.Material.albedo", progress, move |c| {
+            c.set_total(theta_i.len() as u64);
+            install(&pool, || {
+                theta_i
+                    .par_iter()
+                    .map(|t| {
+                        let wi = spherical_direction(t.to_radians(), 0.0);
+                        let r = directional_albedo(
+                            bsdf.as_ref(),
+                            wi,
+                            &BsdfContext::IMPORTANCE,
+                            samples,
+                            seed,
+                        );
+                        c.advance(1);
+                        r
+                    })
+                    .collect::<Vec<_>>()
+            })
+        })?;
         let k = rows.len();
         let pick = |f: &dyn Fn(&(_, _, _, _)) -> facette_bsdf::Spectrum| {
             let mut a = Array2::<f64>::zeros((k, 3));
@@ -276,14 +429,21 @@ impl Material {
     }
 
     /// Every BSDF check of `facette validate --material` (chi-square of the sampler per
-    /// side, pdf/sample consistency, albedo bound, reciprocity, NaN/Inf sweep).
-    #[pyo3(signature = (samples = 200_000, seed = 1))]
-    fn validate(&self, py: Python<'_>, samples: usize, seed: u64) -> PyResult<ValidationReport> {
+    /// side, pdf/sample consistency, albedo bound, reciprocity, NaN/Inf sweep). Progress
+    /// counts the steps (incidences, then the two sweeps).
+    #[pyo3(signature = (samples = 200_000, seed = 1, progress = None))]
+    fn validate(
+        &self,
+        py: Python<'_>,
+        samples: usize,
+        seed: u64,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<ValidationReport> {
         if samples < 1000 {
             return Err(value_error("`samples` must be at least 1000"));
         }
         let bsdf = self.bsdf.clone();
-        let report = py.detach(move || {
+        let report = run_all(py, "facette.Material.validate", progress, move |c| {
             let opts = BsdfCheckOptions {
                 chi2: Chi2Config {
                     samples,
@@ -293,9 +453,12 @@ impl Material {
                 ..BsdfCheckOptions::default()
             };
             let mut r = Report::new();
-            r.extend(check_bsdf(bsdf.as_ref(), &opts));
+            r.extend(check_bsdf_watched(bsdf.as_ref(), &opts, &|d, t| {
+                c.progress(d as u64, t as u64);
+                !c.cancelled()
+            }));
             r
-        });
+        })?;
         Ok(ValidationReport::from(&report))
     }
 }

@@ -3,7 +3,8 @@
 //! docs/file-formats.md), and their merges.
 
 use crate::errors::{os_error, value_error};
-use crate::render::{film_array, options, scene_from};
+use crate::interrupt;
+use crate::render::{film_array, options, scene_arg};
 use crate::toml_value::table_from_py;
 use facette_bsdf::models::il::il_table::BodyTable;
 use facette_bsdf::models::il::il_table_part::{merge_table_parts as merge_tables, TablePart};
@@ -16,58 +17,84 @@ use numpy::{IntoPyArray, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
-/// Renders part `part` of `parts` of a scene's samples; returns the `.fcpart` bytes.
+/// Renders part `part` of `parts` of a scene's samples; returns the `.fcpart` bytes. An
+/// interrupted part is never returned (it would merge as a wrong image).
 #[pyfunction]
-#[pyo3(signature = (scene, part, parts, spp = None, seed = 0, threads = None))]
+#[pyo3(signature = (kind, scene, part, parts, spp = None, seed = 0, threads = None,
+    defines = None, width = None, height = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn render_part<'py>(
     py: Python<'py>,
-    scene: &str,
+    kind: &str,
+    scene: &Bound<'py, PyAny>,
     part: u32,
     parts: u32,
     spp: Option<usize>,
     seed: u64,
     threads: Option<usize>,
+    defines: Option<Vec<(String, String)>>,
+    width: Option<usize>,
+    height: Option<usize>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyBytes>> {
-    let opts = options(spp, seed, threads)?;
-    let scene = scene.to_string();
-    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
-        let s = scene_from(&scene)?;
-        let (p, _) = facette_render::partial_film::render_part(
-            &s,
-            &opts,
-            part,
-            parts,
-            &AtomicBool::new(false),
-            &|_, _| {},
-        )
-        .map_err(value_error)?;
-        Ok(p.to_bytes())
-    })?;
+    let opts = options(spp, seed, threads, None)?;
+    let arg = scene_arg(kind, scene, defines, width, height)?;
+    let bytes = interrupt::run_all(py, "facette.render_part", progress, move |c| {
+        let s = arg.load()?;
+        let (p, _) =
+            facette_render::partial_film::render_part(&s, &opts, part, parts, c.flag(), &|d, t| {
+                c.progress(d, t)
+            })
+            .map_err(value_error)?;
+        PyResult::Ok(p.to_bytes())
+    })??;
     Ok(PyBytes::new(py, &bytes))
 }
 
 /// The N parts rendered in this process and merged: the reference a distributed render
 /// reproduces bit for bit. Returns (H, W, 3) float32 times 2^(scene exposure).
 #[pyfunction]
-#[pyo3(signature = (scene, parts, spp = None, seed = 0, threads = None))]
+#[pyo3(signature = (kind, scene, parts, spp = None, seed = 0, threads = None,
+    defines = None, width = None, height = None, progress = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn render_in_parts<'py>(
     py: Python<'py>,
-    scene: &str,
+    kind: &str,
+    scene: &Bound<'py, PyAny>,
     parts: u32,
     spp: Option<usize>,
     seed: u64,
     threads: Option<usize>,
+    defines: Option<Vec<(String, String)>>,
+    width: Option<usize>,
+    height: Option<usize>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let opts = options(spp, seed, threads)?;
-    let scene = scene.to_string();
-    let a = py.detach(move || -> PyResult<_> {
-        let s = scene_from(&scene)?;
-        let film =
-            facette_render::partial_film::render_in_parts(&s, &opts, parts).map_err(value_error)?;
+    let opts = options(spp, seed, threads, None)?;
+    let arg = scene_arg(kind, scene, defines, width, height)?;
+    let a = interrupt::run_all(py, "facette.render_in_parts", progress, move |c| {
+        let s = arg.load()?;
+        // `partial_film::render_in_parts`, part by part, so that Ctrl-C stops it.
+        let mut films = Vec::new();
+        for k in 0..parts {
+            let (p, _) = facette_render::partial_film::render_part(
+                &s,
+                &opts,
+                k,
+                parts,
+                c.flag(),
+                &|d, t| c.progress(d + k as u64 * t, t * parts as u64),
+            )
+            .map_err(value_error)?;
+            if c.cancelled() {
+                return Err(value_error("interrupted"));
+            }
+            films.push(p);
+        }
+        let film = merge_parts(&films).map_err(value_error)?;
         Ok(film_array(&film, s.film.exposure))
-    })?;
+    })??;
     Ok(a.into_pyarray(py))
 }
 
@@ -80,7 +107,7 @@ pub fn merge_render_parts<'py>(
     parts: Vec<Vec<u8>>,
     exposure: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let a = py.detach(move || -> PyResult<_> {
+    let a = interrupt::run_all(py, "facette.merge_render_parts", None, move |_| {
         let films: Vec<PartialFilm> = parts
             .iter()
             .enumerate()
@@ -89,8 +116,8 @@ pub fn merge_render_parts<'py>(
             .map_err(value_error)?;
         let film = merge_parts(&films).map_err(value_error)?;
         let e = exposure.unwrap_or(films[0].exposure);
-        Ok(film_array(&film, e))
-    })?;
+        PyResult::Ok(film_array(&film, e))
+    })??;
     Ok(a.into_pyarray(py))
 }
 
@@ -99,61 +126,75 @@ fn il_lobe(
     material: &Bound<'_, PyAny>,
 ) -> PyResult<(facette_bsdf::microfacet::specular_lobe::SpecularLobe, f64)> {
     let table = table_from_py(material)?;
-    let ty = table.get("type").and_then(|v| v.as_str()).unwrap_or("");
-    if ty != "il" && ty != "interfaced-lambertian" {
-        return Err(value_error(format!(
-            "tabulate needs an interfaced-Lambertian material (type = \"il\"), got type `{ty}`"
-        )));
-    }
-    facette_bsdf::recipe::build_material(&table).map_err(value_error)?;
-    let p = Params::new(&table, "material \"il\"");
-    let ni = p.f64_or("ni", 1.5).map_err(value_error)?;
-    let ndf = parse_distribution(&p, true)
-        .map_err(value_error)?
-        .ok_or_else(|| {
-            value_error("the material is flat (alpha = 0): its body term needs no table")
-        })?;
-    let masking = parse_masking(&p, Some(&ndf)).map_err(value_error)?;
-    let sampling = parse_sampling(&p).map_err(value_error)?;
-    let lobe = facette_bsdf::microfacet::specular_lobe::SpecularLobe::new(ndf, masking, sampling)
+    interrupt::guard("facette.tabulate", || {
+        let ty = table.get("type").and_then(|v| v.as_str()).unwrap_or("");
+        if ty != "il" && ty != "interfaced-lambertian" {
+            return Err(value_error(format!(
+                "tabulate needs an interfaced-Lambertian material (type = \"il\"), got type `{ty}`"
+            )));
+        }
+        facette_bsdf::recipe::build_material(&table).map_err(value_error)?;
+        let p = Params::new(&table, "material \"il\"");
+        let ni = p.f64_or("ni", 1.5).map_err(value_error)?;
+        let ndf = parse_distribution(&p, true)
+            .map_err(value_error)?
+            .ok_or_else(|| {
+                value_error("the material is flat (alpha = 0): its body term needs no table")
+            })?;
+        let masking = parse_masking(&p, Some(&ndf)).map_err(value_error)?;
+        let sampling = parse_sampling(&p).map_err(value_error)?;
+        let lobe =
+            facette_bsdf::microfacet::specular_lobe::SpecularLobe::new(ndf, masking, sampling)
+                .map_err(value_error)?;
+        // Validates the combination as the material would.
+        InterfacedLambertian::new(
+            facette_bsdf::Spectrum::splat(0.5),
+            ni,
+            Some(lobe.clone()),
+            BodyEvaluation::Stochastic,
+            Scattering::Single,
+        )
         .map_err(value_error)?;
-    // Validates the combination as the material would.
-    InterfacedLambertian::new(
-        facette_bsdf::Spectrum::splat(0.5),
-        ni,
-        Some(lobe.clone()),
-        BodyEvaluation::Stochastic,
-        Scattering::Single,
-    )
-    .map_err(value_error)?;
-    Ok((lobe, ni))
+        Ok((lobe, ni))
+    })
+}
+
+/// Checks that `material` can be tabulated (a rough IL material): the driver-side check
+/// of a distributed table.
+#[pyfunction]
+pub fn check_table_material(material: &Bound<'_, PyAny>) -> PyResult<()> {
+    il_lobe(material).map(|_| ())
 }
 
 /// Tabulates the body term of an IL material (`facette tabulate`); returns the `.fctab`
 /// bytes and writes them to `output` when given.
 #[pyfunction]
-#[pyo3(signature = (material, step = 5.0, samples = 10_000, output = None))]
+#[pyo3(signature = (material, step = 5.0, samples = 10_000, output = None, progress = None))]
 pub fn tabulate<'py>(
     py: Python<'py>,
     material: &Bound<'py, PyAny>,
     step: f64,
     samples: usize,
     output: Option<std::path::PathBuf>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let (lobe, ni) = il_lobe(material)?;
-    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
-        let t = BodyTable::build(&lobe, ni, step, samples, &|_, _| {}).map_err(value_error)?;
+    let bytes = interrupt::run_all(py, "facette.tabulate", progress, move |c| {
+        let t = BodyTable::build(&lobe, ni, step, samples, &|d, t| {
+            c.progress(d as u64, t as u64)
+        })
+        .map_err(value_error)?;
         if let Some(o) = &output {
             t.save(o).map_err(os_error)?;
         }
-        Ok(t.to_bytes())
-    })?;
+        PyResult::Ok(t.to_bytes())
+    })??;
     Ok(PyBytes::new(py, &bytes))
 }
 
 /// Part `part` of `parts` of a table (`facette tabulate --part`); returns `.fctpart` bytes.
 #[pyfunction]
-#[pyo3(signature = (material, part, parts, step = 5.0, samples = 10_000))]
+#[pyo3(signature = (material, part, parts, step = 5.0, samples = 10_000, progress = None))]
 pub fn tabulate_part<'py>(
     py: Python<'py>,
     material: &Bound<'py, PyAny>,
@@ -161,13 +202,16 @@ pub fn tabulate_part<'py>(
     parts: u32,
     step: f64,
     samples: usize,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let (lobe, ni) = il_lobe(material)?;
-    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
-        let p = TablePart::build(&lobe, ni, step, samples, part, parts, &|_, _| {})
-            .map_err(value_error)?;
-        Ok(p.to_bytes())
-    })?;
+    let bytes = interrupt::run_all(py, "facette.tabulate_part", progress, move |c| {
+        let p = TablePart::build(&lobe, ni, step, samples, part, parts, &|d, t| {
+            c.progress(d as u64, t as u64)
+        })
+        .map_err(value_error)?;
+        PyResult::Ok(p.to_bytes())
+    })??;
     Ok(PyBytes::new(py, &bytes))
 }
 
@@ -180,7 +224,7 @@ pub fn merge_table_parts<'py>(
     parts: Vec<Vec<u8>>,
     output: Option<std::path::PathBuf>,
 ) -> PyResult<Bound<'py, PyBytes>> {
-    let bytes = py.detach(move || -> PyResult<Vec<u8>> {
+    let bytes = interrupt::run_all(py, "facette.merge_table_parts", None, move |_| {
         let ps: Vec<TablePart> = parts
             .iter()
             .enumerate()
@@ -191,7 +235,7 @@ pub fn merge_table_parts<'py>(
         if let Some(o) = &output {
             t.save(o).map_err(os_error)?;
         }
-        Ok(t.to_bytes())
-    })?;
+        PyResult::Ok(t.to_bytes())
+    })??;
     Ok(PyBytes::new(py, &bytes))
 }

@@ -92,12 +92,28 @@ fn incident_directions(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Vec<(String,
 
 /// Every check for one BSDF.
 pub fn check_bsdf(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Vec<Check> {
+    check_bsdf_watched(bsdf, opts, &|_, _| true)
+}
+
+/// [`check_bsdf`], calling `watch(steps done, steps)` before each step (an incidence, then
+/// the reciprocity and NaN/Inf sweeps) and stopping — with the checks done so far — when
+/// it returns false: the hook through which the Python package reports progress and
+/// stops on Ctrl-C.
+pub fn check_bsdf_watched(
+    bsdf: &dyn Bsdf,
+    opts: &BsdfCheckOptions,
+    watch: &dyn Fn(usize, usize) -> bool,
+) -> Vec<Check> {
     let subject = bsdf.describe();
     let mut out = Vec::new();
     let dirs = incident_directions(bsdf, opts);
     let ctx = BsdfContext::RADIANCE;
     let width = bsdf.lobe_width();
+    let steps = dirs.len() + 2;
     for (k, (label, wo)) in dirs.iter().enumerate() {
+        if !watch(k, steps) {
+            return out;
+        }
         let wo = *wo;
         if bsdf.flags().has_smooth_part() {
             // Broad lobes: one test over the whole sphere. Narrow lobes: one test per side,
@@ -210,10 +226,17 @@ pub fn check_bsdf(bsdf: &dyn Bsdf, opts: &BsdfCheckOptions) -> Vec<Check> {
         }
         out.push(albedo_check(bsdf, wo, label, opts));
     }
+    if !watch(dirs.len(), steps) {
+        return out;
+    }
     if bsdf.flags().has_smooth_part() {
         out.push(reciprocity_check(bsdf, opts));
     }
+    if !watch(dirs.len() + 1, steps) {
+        return out;
+    }
     out.push(sweep_check(bsdf, opts));
+    watch(steps, steps);
     out
 }
 

@@ -1,15 +1,19 @@
 from os import PathLike
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
 
-MaterialSpec = Union[str, Mapping[str, Any]]
-Scene = Union[str, PathLike[str]]
+MaterialSpec = Union[str, Mapping[str, Any], "Material"]
+# A path (str or PathLike), TOML text, Mitsuba XML text, or a dict in the TOML grammar.
+Scene = Union[str, PathLike[str], Mapping[str, Any]]
 Path = Union[str, PathLike[str]]
 ArrayLike = npt.ArrayLike
+# False/None: silent; True: a line on stderr; a callable: called with (done, total).
+Progress = Union[bool, None, Callable[[int, int], Any]]
+Defines = Optional[Mapping[str, Any]]
 
 class ValidationCheck:
     subject: str
@@ -28,18 +32,47 @@ class Material:
     def description(self) -> str: ...
     @property
     def is_stochastic(self) -> bool: ...
+    @property
+    def spec(self) -> dict[str, Any]: ...
+    @property
+    def toml(self) -> str: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
     def eval(
-        self, wi: ArrayLike, wo: ArrayLike, samples: int = ..., mode: str = ..., seed: int = ...
+        self,
+        wi: ArrayLike,
+        wo: ArrayLike,
+        samples: int = ...,
+        mode: str = ...,
+        seed: int = ...,
+        *,
+        cosine: bool = ...,
+        threads: Optional[int] = ...,
+        progress: Progress = ...,
     ) -> npt.NDArray[np.float64]: ...
-    def pdf(self, wo: ArrayLike, wi: ArrayLike, mode: str = ...) -> npt.NDArray[np.float64]: ...
+    def pdf(
+        self, wi: ArrayLike, wo: ArrayLike, mode: str = ..., *, threads: Optional[int] = ...
+    ) -> npt.NDArray[np.float64]: ...
     def sample(
-        self, wo: ArrayLike, u: Optional[ArrayLike] = ..., mode: str = ..., seed: int = ...
+        self,
+        wo: ArrayLike,
+        u: Optional[ArrayLike] = ...,
+        mode: str = ...,
+        seed: int = ...,
+        *,
+        threads: Optional[int] = ...,
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], list[str]]: ...
     def albedo(
-        self, theta_i: Union[float, Sequence[float]], samples: int = ..., seed: int = ...
+        self,
+        theta_i: Union[float, Sequence[float]],
+        samples: int = ...,
+        seed: int = ...,
+        *,
+        threads: Optional[int] = ...,
+        progress: Progress = ...,
     ) -> dict[str, npt.NDArray[np.float64]]: ...
     def to_merl(self, path: Path, noise: float = ..., seed: int = ...) -> int: ...
-    def validate(self, samples: int = ..., seed: int = ...) -> ValidationReport: ...
+    def validate(self, samples: int = ..., seed: int = ..., *, progress: Progress = ...) -> ValidationReport: ...
 
 def render(
     scene: Scene,
@@ -47,18 +80,47 @@ def render(
     seed: int = ...,
     threads: Optional[int] = ...,
     exposure: Optional[float] = ...,
+    *,
+    defines: Defines = ...,
+    width: Optional[int] = ...,
+    height: Optional[int] = ...,
+    time_limit: Optional[float] = ...,
+    progress: Progress = ...,
 ) -> npt.NDArray[np.float32]: ...
 def render_part(
-    scene: Scene, part: int, parts: int, spp: Optional[int] = ..., seed: int = ..., threads: Optional[int] = ...
+    scene: Scene,
+    part: int,
+    parts: int,
+    spp: Optional[int] = ...,
+    seed: int = ...,
+    threads: Optional[int] = ...,
+    *,
+    defines: Defines = ...,
+    width: Optional[int] = ...,
+    height: Optional[int] = ...,
+    progress: Progress = ...,
 ) -> bytes: ...
 def render_in_parts(
-    scene: Scene, parts: int, spp: Optional[int] = ..., seed: int = ..., threads: Optional[int] = ...
+    scene: Scene,
+    parts: int,
+    spp: Optional[int] = ...,
+    seed: int = ...,
+    threads: Optional[int] = ...,
+    *,
+    defines: Defines = ...,
+    width: Optional[int] = ...,
+    height: Optional[int] = ...,
+    progress: Progress = ...,
 ) -> npt.NDArray[np.float32]: ...
 def merge_render_parts(parts: Sequence[bytes], exposure: Optional[float] = ...) -> npt.NDArray[np.float32]: ...
 def write_image(path: Path, image: ArrayLike, exposure: float = ...) -> None: ...
 def read_image(path: Path, linear: bool = ...) -> npt.NDArray[np.float32]: ...
-def tabulate(material: MaterialSpec, step: float = ..., samples: int = ..., output: Optional[Path] = ...) -> bytes: ...
-def tabulate_part(material: MaterialSpec, part: int, parts: int, step: float = ..., samples: int = ...) -> bytes: ...
+def tabulate(
+    material: MaterialSpec, step: float = ..., samples: int = ..., output: Optional[Path] = ..., *, progress: Progress = ...
+) -> bytes: ...
+def tabulate_part(
+    material: MaterialSpec, part: int, parts: int, step: float = ..., samples: int = ..., *, progress: Progress = ...
+) -> bytes: ...
 def merge_table_parts(parts: Sequence[bytes], output: Optional[Path] = ...) -> bytes: ...
 def fit(
     path: Path,
@@ -71,5 +133,7 @@ def fit(
     max_theta: float = ...,
     seed: int = ...,
     output: Optional[Path] = ...,
+    *,
+    progress: Progress = ...,
 ) -> dict[str, Any]: ...
-def measure(material: Union[Material, MaterialSpec], path: Path, noise: float = ..., seed: int = ...) -> int: ...
+def measure(material: MaterialSpec, path: Path, noise: float = ..., seed: int = ...) -> int: ...

@@ -3,7 +3,7 @@ from typing import Optional, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from . import MaterialSpec, Path, Scene
+from . import Defines, MaterialSpec, Path, Scene
 
 def render(
     scene: Scene,
@@ -16,6 +16,7 @@ def render(
     threads_per_task: int = ...,
     max_retries: int = ...,
     progress: bool = ...,
+    defines: Defines = ...,
 ) -> npt.NDArray[np.float32]: ...
 def tabulate(
     material: MaterialSpec,
