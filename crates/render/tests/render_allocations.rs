@@ -3,6 +3,7 @@
 //! measures the allocations of two renders that differ only in their sample count and
 //! attributes the difference to the extra samples.
 
+use facette_render::kernel::Kernel;
 use facette_render::render::{render, RenderOptions};
 use facette_render::scene::load_scene_str;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -92,11 +93,12 @@ radiance = 0.2
 "#;
 
 /// Allocations made by one single-threaded render of `spp` samples per pixel.
-fn allocations(spp: usize) -> u64 {
+fn allocations(spp: usize, kernel: Kernel) -> u64 {
     let scene = load_scene_str(SCENE, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"));
     let opts = RenderOptions {
         spp: Some(spp),
         threads: Some(1),
+        kernel: Some(kernel),
         ..Default::default()
     };
     let before = ALLOCATIONS.load(Ordering::Relaxed);
@@ -111,13 +113,17 @@ fn a_render_allocates_nothing_per_sample() {
     // 17 and 20 passes of one 32 × 32 tile: the few per-pass allocations cancel out to a
     // handful, and the rest of the difference is what the 32 × 32 × 224 extra samples
     // allocate (one per sample or per vertex would be ≥ 229,376).
-    let few = allocations(32);
-    let many = allocations(256);
-    let extra_samples = (32 * 32 * (256 - 32)) as f64;
-    let per_sample = many.saturating_sub(few) as f64 / extra_samples;
-    println!("allocations: {few} at 32 spp, {many} at 256 spp ({per_sample:.2e} per sample)");
-    assert!(
-        per_sample < 1e-3,
-        "{per_sample} heap allocations per extra camera sample ({few} → {many})"
-    );
+    for kernel in [Kernel::Scalar, Kernel::Packet] {
+        let few = allocations(32, kernel);
+        let many = allocations(256, kernel);
+        let extra_samples = (32 * 32 * (256 - 32)) as f64;
+        let per_sample = many.saturating_sub(few) as f64 / extra_samples;
+        println!(
+            "{kernel:?}: allocations {few} at 32 spp, {many} at 256 spp ({per_sample:.2e} per sample)"
+        );
+        assert!(
+            per_sample < 1e-3,
+            "{kernel:?}: {per_sample} heap allocations per extra camera sample ({few} → {many})"
+        );
+    }
 }

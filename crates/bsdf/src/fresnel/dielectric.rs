@@ -8,7 +8,6 @@ use crate::lanes::Real;
 /// incidence (unless η = 1, where the interface vanishes and F = 0).
 ///
 /// F = ½ (g−c)²/(g+c)² [1 + (c(g+c)−1)²/(c(g−c)+1)²], g = √(η² − 1 + c²).
-
 #[inline]
 pub fn fresnel_dielectric(cos_theta: f64, eta: f64) -> f64 {
     fresnel_dielectric_lanes(cos_theta, eta)

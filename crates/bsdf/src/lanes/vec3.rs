@@ -2,6 +2,7 @@
 
 use super::real::Real;
 use crate::math::Vec3;
+use std::ops::{Add, Neg, Sub};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LVec3<R> {
@@ -54,18 +55,6 @@ impl<R: Real> LVec3<R> {
         LVec3::new(self.x * s, self.y * s, self.z * s)
     }
     #[inline(always)]
-    pub fn add(self, o: Self) -> Self {
-        LVec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
-    }
-    #[inline(always)]
-    pub fn sub(self, o: Self) -> Self {
-        LVec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
-    }
-    #[inline(always)]
-    pub fn neg(self) -> Self {
-        LVec3::new(-self.x, -self.y, -self.z)
-    }
-    #[inline(always)]
     pub fn length_squared(self) -> R {
         self.dot(self)
     }
@@ -81,6 +70,30 @@ impl<R: Real> LVec3<R> {
             R::select(m, a.y, b.y),
             R::select(m, a.z, b.z),
         )
+    }
+}
+
+impl<R: Real> Add for LVec3<R> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        LVec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl<R: Real> Sub for LVec3<R> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        LVec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl<R: Real> Neg for LVec3<R> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        LVec3::new(-self.x, -self.y, -self.z)
     }
 }
 

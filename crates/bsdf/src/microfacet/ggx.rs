@@ -135,7 +135,7 @@ impl Ggx {
         let h = R::splat(0.5) * (R::one() + vh.z);
         let p2 = (R::one() - h) * (R::one() - p1 * p1).max(R::zero()).sqrt() + h * p2;
         let nz = (R::one() - p1 * p1 - p2 * p2).max(R::zero()).sqrt();
-        let nh = t1.scale(p1).add(t2.scale(p2)).add(vh.scale(nz));
+        let nh = t1.scale(p1) + t2.scale(p2) + vh.scale(nz);
         LVec3::new(ax * nh.x, ay * nh.y, nh.z.max(R::splat(R::TINY))).normalize()
     }
 }

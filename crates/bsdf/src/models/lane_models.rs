@@ -38,7 +38,7 @@ impl LaneNdf {
     pub fn from_ndf(ndf: &Ndf) -> Option<LaneNdf> {
         match ndf {
             Ndf::Ggx(g) => Some(LaneNdf::Ggx(*g)),
-            Ndf::Beckmann(b) => Some(LaneNdf::Beckmann(b.clone())),
+            Ndf::Beckmann(b) => Some(LaneNdf::Beckmann(*b)),
             _ => None,
         }
     }
@@ -234,7 +234,7 @@ impl LaneBsdf {
             LaneBsdf::Conductor { ndf, fresnel, tint } => {
                 let s = upper(wo);
                 let (o, i) = (mirror(wo, s), mirror(wi, s));
-                let h = o.add(i).normalize();
+                let h = (o + i).normalize();
                 let cos_oh = o.dot(h);
                 let ok = (wo.z * wi.z).gt(R::zero()) & h.z.gt(R::zero()) & cos_oh.gt(R::zero());
                 let d = ndf.d(h);
@@ -268,9 +268,9 @@ impl LaneBsdf {
         let index = |w: LVec3<R>| R::select(w.z.gt(zero), R::one(), R::splat(eta));
         let (n_i, n_o) = (index(wi), index(wo));
         // The generalized half vector [WMLT07 eq. 16], on the upper side.
-        let ht = wi.scale(n_i).add(wo.scale(n_o)).neg();
-        let h = LVec3::select(refl, wi.add(wo), ht).normalize();
-        let h = LVec3::select(h.z.lt(zero), h.neg(), h);
+        let ht = -(wi.scale(n_i) + wo.scale(n_o));
+        let h = LVec3::select(refl, wi + wo, ht).normalize();
+        let h = LVec3::select(h.z.lt(zero), -h, h);
         let (ih, oh) = (wi.dot(h), wo.dot(h));
         let ok = h.z.gt(zero)
             & (ih * wi.z).gt(zero)
@@ -327,7 +327,7 @@ impl LaneBsdf {
                 let o = mirror(wo, s);
                 let m = ndf.sample_visible(o, u0, u1);
                 let c = o.dot(m);
-                let i = m.scale(R::splat(2.0) * c).sub(o);
+                let i = m.scale(R::splat(2.0) * c) - o;
                 let d = ndf.d(m);
                 let pdf = ndf.pdf_visible(o, m, d) / (R::splat(4.0) * c);
                 let w = ndf.g(i, o, m) / ndf.g1_visible(o);
@@ -381,13 +381,11 @@ impl LaneBsdf {
         let pm = ndf.pdf_visible(up, m, d);
         let f = fresnel_dielectric_lanes(c.abs(), n_t / n_o);
         let choose_r = u_lobe.lt(f);
-        let wr = m.scale(R::splat(2.0) * c).sub(wo);
+        let wr = m.scale(R::splat(2.0) * c) - wo;
         // Refraction through m [WMLT07 eq. 40], relative index n_o/n_t.
         let e = n_o / n_t;
         let k = one + e * e * (c * c - one);
-        let wt = m
-            .scale(e * c - c.sign_or_one() * k.max(zero).sqrt())
-            .sub(wo.scale(e));
+        let wt = m.scale(e * c - c.sign_or_one() * k.max(zero).sqrt()) - wo.scale(e);
         let wi = LVec3::select(choose_r, wr, wt);
         let base = ndf.g(wo, wi, m) / ndf.g1_visible(up);
         let wim = wi.dot(m);
