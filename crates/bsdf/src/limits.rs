@@ -105,12 +105,12 @@ pub const SAMPLES_PER_PIXEL: Limit = Limit {
     lift: "16.7 million samples per pixel; for more, render parts with --part K/N and merge them",
 };
 
-/// Camera samples of a whole render, pixels × spp (counters are 64-bit; this keeps
-/// every per-render count exact in an f64 as well).
+/// Camera samples of a whole render, pixels × spp: 2^40 (10^12) samples take more than a
+/// day at 10 Msamples/s, so a larger product is a mistake (an 8K film at 32768 spp fits).
 pub const RENDER_SAMPLES: Limit = Limit {
     what: "camera samples (width × height × spp)",
-    max: 1 << 50,
-    lift: "lower spp or the film size",
+    max: 1 << 40,
+    lift: "more than a day of rendering; lower spp or the film size",
 };
 
 /// Worker threads.
@@ -186,6 +186,14 @@ pub const SAMPLES: Limit = Limit {
     what: "samples",
     max: 1 << 32,
     lift: "4.3 billion samples; run several seeds and average",
+};
+
+/// A count in a material table that sizes a table or a loop (`samples`, `table_samples`,
+/// `resolution`, `masking_lobes`).
+pub const RECIPE_COUNT: Limit = Limit {
+    what: "a material's count",
+    max: 1 << 24,
+    lift: "16.7 million; the defaults are far below",
 };
 
 /// Files `<include>`d by a Mitsuba scene, all levels together.

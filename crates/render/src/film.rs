@@ -100,7 +100,7 @@ impl Film {
         let sq = [q[0] + l[0] * l[0], q[1] + l[1] * l[1], q[2] + l[2] * l[2]];
         // A finite sample can still overflow the sum (or its square): such a sample is
         // discarded like a non-finite one, so that a pixel never becomes infinite.
-        if !(sums.iter().chain(&sq).all(|v| v.is_finite())) {
+        if !sums.iter().chain(&sq).all(|v| v.is_finite()) {
             self.discarded += 1;
             return false;
         }

@@ -37,7 +37,7 @@ pub(super) fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let density = HalfVectorDensity::new(name, rough)?;
     let ior = check_ior(p.f64_or("ior", 1.5)?)?;
     let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
-    let samples = p.usize("table_samples")?.unwrap_or(16384);
+    let samples = p.count("table_samples")?.unwrap_or(16384);
     p.finish(&keys(KELEMEN_KEYS, false))?;
     Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::new(
         density,

@@ -185,12 +185,13 @@ fn face_index_without_data(bytes: &[u8]) -> Option<(usize, &'static str)> {
             continue;
         }
         for w in words {
-            let mut parts = w.split('/');
-            parts.next();
-            if !has_vt && parts.next().is_some_and(|t| !t.is_empty()) {
+            // `v`, `v/vt`, `v//vn` or `v/vt/vn`.
+            let mut parts = w.split('/').skip(1);
+            let (vt, vn) = (parts.next(), parts.next());
+            if !has_vt && vt.is_some_and(|t| !t.is_empty()) {
                 return Some((k + 1, "texture coordinate"));
             }
-            if !has_vn && parts.next().is_some_and(|n| !n.is_empty()) {
+            if !has_vn && vn.is_some_and(|n| !n.is_empty()) {
                 return Some((k + 1, "normal"));
             }
         }
