@@ -94,6 +94,16 @@ fn part_headers_are_validated_and_merge_never_sizes_from_a_corrupt_count() {
             .to_string();
         assert!(e.contains(expect), "{line}: {e}");
     }
+    // A negative entry (finite, CRC-valid) is refused by the part loader: merged, it would
+    // make a table its own loader refuses (found by the fuzzer, fctpart seed 23 case 690).
+    let mut payload = PART.unframe(&bytes).unwrap().payload.to_vec();
+    let hlen = u32::from_le_bytes(payload[..4].try_into().unwrap()) as usize;
+    let first_value = 4 + hlen + 4 + 8 + 8;
+    payload[first_value..first_value + 8].copy_from_slice(&(-0.5f64).to_le_bytes());
+    let e = TablePart::from_bytes(&PART.frame(&payload), "p.fctpart")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("negative"), "{e}");
     // Merged, the parts make a table its loader accepts.
     let table = merge_table_parts(&parts).unwrap();
     assert!(BodyTable::from_bytes(&table.to_bytes(), "m.fctab").is_ok());

@@ -375,8 +375,7 @@ impl TableGrid {
 /// be finite, divide 90°, and give a grid within [`limits::TABLE_ENTRIES`].
 pub(crate) fn check_step(step_deg: f64) -> Result<usize, String> {
     let intervals = (90.0 / step_deg).round();
-    if !(step_deg > 0.0 && step_deg <= 90.0)
-        || !step_deg.is_finite()
+    if !(step_deg > 0.0 && step_deg <= 90.0 && step_deg.is_finite())
         || (intervals * step_deg - 90.0).abs() > 1e-9
         || intervals < 1.0
     {

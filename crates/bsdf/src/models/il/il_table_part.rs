@@ -183,9 +183,12 @@ impl TablePart {
                 let ph = u32_(take(4)?) as usize;
                 let v = f64::from_le_bytes(take(8)?.try_into().expect("8 bytes"));
                 let se = f64::from_le_bytes(take(8)?.try_into().expect("8 bytes"));
-                if to >= grid.n_theta || ph >= grid.n_phi || !v.is_finite() || !se.is_finite() {
+                // The table's own loader refuses negative values: a part that holds one
+                // would merge into a table that cannot be read back (found by the fuzzer).
+                let valid = |x: f64| x.is_finite() && x >= 0.0;
+                if to >= grid.n_theta || ph >= grid.n_phi || !valid(v) || !valid(se) {
                     return Err(bad(format!(
-                        "row {theta_i}: an entry is outside the grid or not finite"
+                        "row {theta_i}: an entry is outside the grid, negative or not finite"
                     )));
                 }
                 entries.push((to, ph, v, se));
