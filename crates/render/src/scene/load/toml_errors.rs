@@ -30,7 +30,7 @@ pub(super) fn rewrite(message: &str, source: &str, span: Option<Range<usize>>) -
     }
     if let Some(rest) = m.strip_prefix("unknown field ") {
         if let Some((field, valid)) = rest.split_once(", expected ") {
-            let valid = valid.trim_start_matches("one of ").replace('`', "");
+            let valid = valid.trim_start_matches("one of ");
             return format!("unknown key {field}; valid keys: {valid}");
         }
         return format!("unknown key {rest}");
