@@ -11,6 +11,8 @@
 //!   KSK01's half-vector densities; the shared specular microfacet lobe.
 //! - [`fresnel`]: exact dielectric and conductor Fresnel, Schlick, r_e and r_i.
 //! - [`checks`]: the valid range of every shared parameter, defined once.
+//! - [`limits`]: every resource bound (film size, samples, table grid, XML nesting and
+//!   includes, mesh sizes, radiance and exposure), stated once with its checker.
 //! - [`finite`]: the one guard that keeps non-finite values from a renderer (and fails
 //!   loudly in tests).
 //! - [`bsdf`]: the BSDF interface (`eval`, `sample`, `pdf`, flags, transport mode,
@@ -36,6 +38,7 @@ pub mod error;
 pub mod finite;
 pub mod fresnel;
 pub mod lanes;
+pub mod limits;
 pub mod math;
 pub mod microfacet;
 pub mod models;

@@ -21,7 +21,7 @@ pub struct AlbedoArgs {
     #[arg(long = "phi-i", value_name = "DEG", default_value_t = 0.0)]
     phi_i: f64,
     /// Samples per angle.
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::counts::count::<1, { crate::counts::SAMPLES }>)]
     samples: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,

@@ -32,7 +32,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "FILE")]
     input: Option<std::path::PathBuf>,
     /// Estimates averaged per value for stochastic models.
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 100_000, value_parser = crate::counts::count::<1, { crate::counts::SAMPLES }>)]
     samples: usize,
     /// Transport mode (only refraction depends on it).
     #[arg(long, value_enum, default_value = "radiance")]

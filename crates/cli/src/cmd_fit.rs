@@ -25,13 +25,13 @@ pub struct FitArgs {
     #[arg(long = "il-evaluation", default_value = "quadrature")]
     il_evaluation: String,
     /// Microfacets of the IL quadrature.
-    #[arg(long = "il-samples", default_value_t = 128)]
+    #[arg(long = "il-samples", default_value_t = 128, value_parser = crate::counts::count::<1, { crate::counts::QUADRATURE }>)]
     il_samples: usize,
     /// Error metric: log (ln(1 + f cos θ_i) differences) or cosine ((f̂ − f) cos θ_i).
     #[arg(long, default_value = "log")]
     error: String,
     /// Measured values used by the fit (a fixed random subset of the valid bins).
-    #[arg(long, default_value_t = 4000)]
+    #[arg(long, default_value_t = 4000, value_parser = crate::counts::count::<1, { crate::counts::QUADRATURE }>)]
     samples: usize,
     /// Ignore bins with θ_i or θ_o above this angle (degrees).
     #[arg(long = "max-theta", default_value_t = 80.0)]

@@ -18,7 +18,7 @@ enum IlApproxCommand {
     /// Fit the coefficients on the (σ, n_i) grid and write them as Rust source.
     Fit {
         /// Microfacets per quadrature value.
-        #[arg(long, default_value_t = 4096)]
+        #[arg(long, default_value_t = 4096, value_parser = crate::counts::count::<1, { crate::counts::QUADRATURE }>)]
         samples: usize,
         /// Output file (default: print to stdout).
         #[arg(short, long)]
@@ -28,7 +28,7 @@ enum IlApproxCommand {
     /// over σ, n_i and off-grid directions.
     Accuracy {
         /// Microfacets per quadrature value.
-        #[arg(long, default_value_t = 16384)]
+        #[arg(long, default_value_t = 16384, value_parser = crate::counts::count::<1, { crate::counts::QUADRATURE }>)]
         samples: usize,
     },
 }

@@ -37,7 +37,7 @@ struct MaterialsArgs {
     #[arg(long = "label", value_name = "NAME")]
     labels: Vec<String>,
     /// Estimates averaged per value for stochastic models.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = crate::counts::count::<1, { crate::counts::SAMPLES }>)]
     samples: usize,
     /// Seed of the stochastic estimates.
     #[arg(long, default_value_t = 1)]
@@ -70,7 +70,7 @@ struct SliceArgs {
     #[arg(long)]
     log: bool,
     /// Points over −90°…90°.
-    #[arg(long, default_value_t = 181)]
+    #[arg(long, default_value_t = 181, value_parser = crate::counts::count::<2, { crate::counts::POINTS }>)]
     points: usize,
 }
 
@@ -146,9 +146,9 @@ enum PlotKind {
         #[arg(long = "theta-i", value_name = "DEG", default_value_t = 60.0)]
         theta_i: f64,
         /// Microfacets of the reference quadrature.
-        #[arg(long, default_value_t = 65_536)]
+        #[arg(long, default_value_t = 65_536, value_parser = crate::counts::count::<1, { crate::counts::QUADRATURE }>)]
         samples: usize,
-        #[arg(long, default_value_t = 181)]
+        #[arg(long, default_value_t = 181, value_parser = crate::counts::count::<2, { crate::counts::POINTS }>)]
         points: usize,
         #[arg(short, long, value_name = "FILE")]
         output: PathBuf,
@@ -234,6 +234,7 @@ fn slice_options(a: &SliceArgs) -> Result<SliceOptions> {
 }
 
 fn finish(chart: &LineChart, output: &Path, csv: &Option<PathBuf>) -> Result<()> {
+    crate::outputs::check_with_csv(output, csv)?;
     for line in summarize(chart) {
         println!("{line}");
     }
@@ -248,6 +249,7 @@ fn finish(chart: &LineChart, output: &Path, csv: &Option<PathBuf>) -> Result<()>
 
 /// Writes a hemisphere map and, with `--csv`, its cell values.
 fn save_map(map: &HemisphereMap, output: &Path, csv: &Option<PathBuf>) -> Result<()> {
+    crate::outputs::check_with_csv(output, csv)?;
     save_figure(map, output)?;
     if let Some(p) = csv {
         let mut s = String::from("x,y,value\n");
@@ -267,6 +269,7 @@ fn save_map(map: &HemisphereMap, output: &Path, csv: &Option<PathBuf>) -> Result
 pub fn run(a: PlotArgs) -> Result<ExitCode> {
     match a.kind {
         PlotKind::Slice(s) => {
+            crate::outputs::check_with_csv(&s.m.output, &s.m.csv)?;
             let mats = materials(&s.m)?;
             let chart = slice_chart(&mats, &slice_options(&s)?);
             finish(&chart, &s.m.output, &s.m.csv)?;
@@ -320,6 +323,7 @@ fn plot_polar(s: &SliceArgs) -> Result<()> {
         println!("{line}");
     }
     let chart = polar_from_slice(slice, &o);
+    crate::outputs::check_with_csv(&s.m.output, &s.m.csv)?;
     save_figure(&chart, &s.m.output)?;
     if let Some(p) = &s.m.csv {
         facette_bsdf::storage::atomic_file::write_atomically(p, chart_csv(&chart).as_bytes())

@@ -4,6 +4,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use facette_bsdf::limits;
 use facette_render::integrator::Strategy;
 use facette_render::kernel::Kernel;
 use facette_render::render::{render, RenderOptions, RenderStats};
@@ -14,7 +15,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -123,10 +124,14 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
     }
     let spp = a.spp.unwrap_or(scene.film.spp);
     let (w, h) = (scene.film.width, scene.film.height);
+    // The scene's film was checked when loaded; --spp may make the product too large.
+    let total = limits::RENDER_SAMPLES
+        .check_product(&[w as u64, h as u64, spp as u64])
+        .map_err(|e| anyhow::anyhow!("--spp {spp} on a {w}×{h} film: {e}"))?;
 
     let cancel = Arc::new(AtomicBool::new(false));
     install_interrupt_handler(&cancel);
-    let pb = progress_bar((w * h * spp) as u64, a.quiet);
+    let pb = progress_bar(total, a.quiet);
     let start = Instant::now();
     let progress = |done: u64, total: u64| {
         pb.set_length(total);
@@ -157,6 +162,7 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
             return Ok(ExitCode::from(130));
         }
         let (partial, stats) = res.map_err(anyhow::Error::msg)?;
+        start_writing();
         partial.save(&output)?;
         if !a.quiet {
             eprintln!(
@@ -175,6 +181,7 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
 
     let exposure = a.exposure.unwrap_or(scene.film.exposure);
     let image = film.image();
+    start_writing();
     facette_render::image::write_image(&output, &image, exposure)
         .with_context(|| format!("writing {}", output.display()))?;
 
@@ -213,32 +220,59 @@ fn check_args(a: &RenderArgs, is_part: bool) -> Result<()> {
         if s == 0 {
             bail!("--spp must be at least 1");
         }
+        limits::SAMPLES_PER_PIXEL
+            .check_usize(s)
+            .map_err(|e| anyhow::anyhow!("--spp: {e}"))?;
     }
     if let Some(t) = a.threads {
         if t == 0 {
             bail!("--threads must be at least 1");
         }
+        limits::THREADS
+            .check_usize(t)
+            .map_err(|e| anyhow::anyhow!("--threads: {e}"))?;
     }
     if let Some(t) = a.time_limit {
-        if !(t.is_finite() && t > 0.0) {
-            bail!("--time-limit must be a positive number of seconds, got {t}");
+        let max = limits::TIME_LIMIT_SECONDS;
+        if !(t.is_finite() && t > 0.0 && t <= max) {
+            bail!(
+                "--time-limit must be a number of seconds in (0, {max:e}], got {}",
+                facette_bsdf::math::fmt_num(t)
+            );
         }
     }
     if let Some(e) = a.exposure {
-        if !e.is_finite() {
-            bail!("--exposure must be a finite number of stops, got {e}");
-        }
+        limits::check_exposure(e).map_err(|m| anyhow::anyhow!("--exposure: {m}"))?;
     }
     Ok(())
 }
 
+/// What the process is doing, for the Ctrl-C handler: a second Ctrl-C exits at once while
+/// rendering (nothing written), but not while the output is being written — exiting then
+/// would leave a temporary file beside the output, or an image written after the message
+/// "exiting without writing". The lock makes the check and the exit one step with respect
+/// to the start of the write.
+static WRITING: Mutex<bool> = Mutex::new(false);
+
+/// Marks the start of the output's write: from now on a Ctrl-C lets the write finish.
+fn start_writing() {
+    *WRITING.lock().unwrap_or_else(|p| p.into_inner()) = true;
+}
+
 /// Ctrl-C sets `cancel` (the render stops after the tiles in flight and writes what it
-/// has); a second Ctrl-C exits at once (nothing is written; the previous output stays).
+/// has); a second Ctrl-C exits at once without writing (the previous output stays) unless
+/// the write has started, which then completes.
 fn install_interrupt_handler(cancel: &Arc<AtomicBool>) {
     let cancel = cancel.clone();
     let res = ctrlc::set_handler(move || {
+        let writing = WRITING.lock().unwrap_or_else(|p| p.into_inner());
+        if *writing {
+            eprintln!("\ninterrupted while writing the output: the write completes first");
+            return;
+        }
         if cancel.swap(true, Ordering::SeqCst) {
             eprintln!("\ninterrupted twice: exiting without writing");
+            // Exits with the lock held, so the write cannot start meanwhile.
             std::process::exit(130);
         }
         eprintln!("\nstopping: finishing the tiles in flight, then writing the image so far (Ctrl-C again to abort)");

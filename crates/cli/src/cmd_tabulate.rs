@@ -24,7 +24,7 @@ pub struct TabulateArgs {
     #[arg(long, default_value_t = 5.0)]
     step: f64,
     /// Microfacet samples per entry.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = 10_000, value_parser = crate::counts::count::<8, { crate::counts::QUADRATURE }>)]
     samples: usize,
     /// Output file (.fctab).
     #[arg(short, long, value_name = "FILE")]
@@ -34,7 +34,7 @@ pub struct TabulateArgs {
     #[arg(long, value_name = "K/N")]
     part: Option<String>,
     /// Compare the table with the quadrature on this many random off-grid direction pairs.
-    #[arg(long, value_name = "K", default_value_t = 0)]
+    #[arg(long, value_name = "K", default_value_t = 0, value_parser = crate::counts::count::<0, { crate::counts::QUADRATURE }>)]
     check: usize,
 }
 

@@ -32,7 +32,7 @@ pub struct ValidateArgs {
     #[arg(long, value_enum)]
     family: Option<FamilyArg>,
     /// Samples per chi-square test.
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::counts::count::<1, { crate::counts::SAMPLES }>)]
     samples: usize,
     /// Seed of every random stream (results are reproducible for a given seed).
     #[arg(long, default_value_t = 7)]

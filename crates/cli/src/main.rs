@@ -13,7 +13,9 @@ mod cmd_render;
 mod cmd_reproduce;
 mod cmd_tabulate;
 mod cmd_validate;
+mod counts;
 mod material_arg;
+mod outputs;
 mod progress;
 
 use clap::{Parser, Subcommand};

@@ -153,8 +153,10 @@ impl MerlBrdf {
         let dims: Vec<i32> = (0..3)
             .map(|k| i32::from_le_bytes(bytes[4 * k..4 * k + 4].try_into().expect("4 bytes")))
             .collect();
-        let product = dims.iter().map(|&d| d as i64).product::<i64>();
-        if dims.iter().any(|&d| d <= 0) || product != BINS as i64 {
+        // Checked before any arithmetic on them: three random int32s overflow a product.
+        let product = dims.iter().try_fold(1i64, |p, &d| p.checked_mul(d as i64));
+        if dims.iter().any(|&d| d <= 0) || product != Some(BINS as i64) {
+            let product = product.map_or("more than 2^63".to_string(), |p| p.to_string());
             return Err(bad(format!(
                 "dimensions {} × {} × {} (product {product}); a MERL file has 90 × 90 × 180 = {BINS}",
                 dims[0], dims[1], dims[2]
@@ -196,6 +198,19 @@ impl MerlBrdf {
     /// Reads a MERL file.
     pub fn load(path: &Path) -> Result<MerlBrdf, MerlError> {
         let p = path.display().to_string();
+        // The format has one size: a larger file is refused before it is read into memory
+        // (a shorter one is read, for the message about its header).
+        if let Ok(m) = std::fs::metadata(path) {
+            if m.is_file() && m.len() > FILE_BYTES as u64 {
+                return Err(MerlError::Invalid {
+                    path: p,
+                    reason: format!(
+                        "{} bytes; a MERL file has exactly {FILE_BYTES} (12 header bytes + 3 × {BINS} float64 values)",
+                        m.len()
+                    ),
+                });
+            }
+        }
         let bytes = std::fs::read(path).map_err(|e| MerlError::Io {
             path: p.clone(),
             source: e,

@@ -95,10 +95,17 @@ impl Film {
             self.discarded += 1;
             return false;
         }
-        for c in 0..3 {
-            self.sums[index][c] += l[c];
-            self.sq_sums[index][c] += l[c] * l[c];
+        let (s, q) = (self.sums[index], self.sq_sums[index]);
+        let sums = [s[0] + l[0], s[1] + l[1], s[2] + l[2]];
+        let sq = [q[0] + l[0] * l[0], q[1] + l[1] * l[1], q[2] + l[2] * l[2]];
+        // A finite sample can still overflow the sum (or its square): such a sample is
+        // discarded like a non-finite one, so that a pixel never becomes infinite.
+        if !sums.iter().chain(&sq).all(|v| v.is_finite()) {
+            self.discarded += 1;
+            return false;
         }
+        self.sums[index] = sums;
+        self.sq_sums[index] = sq;
         true
     }
 
@@ -113,7 +120,10 @@ impl Film {
                     [0.0; 3]
                 } else {
                     let k = 1.0 / n as f64;
-                    [(s[0] * k) as f32, (s[1] * k) as f32, (s[2] * k) as f32]
+                    // A mean beyond f32 (only from sums near f64's limit) saturates
+                    // rather than becoming an infinite pixel.
+                    let m = |v: f64| (v * k).min(f32::MAX as f64) as f32;
+                    [m(s[0]), m(s[1]), m(s[2])]
                 }
             })
             .collect();

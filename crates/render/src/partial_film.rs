@@ -200,9 +200,22 @@ pub fn merge_parts(parts: &[PartialFilm]) -> Result<Film, PartError> {
                 film.sums[i][c] += f.sums[i][c];
                 film.sq_sums[i][c] += f.sq_sums[i][c];
             }
-            film.counts[i] += f.counts[i];
+            // Corrupt (but CRC-valid) parts must not overflow the sums or the counts.
+            let count = film.counts[i].checked_add(f.counts[i]);
+            if count.is_none_or(|c| c > first.spp)
+                || !film.sums[i]
+                    .iter()
+                    .chain(&film.sq_sums[i])
+                    .all(|v| v.is_finite())
+            {
+                return Err(PartError::Mismatch(format!(
+                    "pixel {i}: the parts' sums or sample counts exceed what {} spp can give (corrupt parts?)",
+                    first.spp
+                )));
+            }
+            film.counts[i] = count.unwrap_or(0);
         }
-        film.discarded += f.discarded;
+        film.discarded = film.discarded.saturating_add(f.discarded);
     }
     Ok(film)
 }
@@ -281,9 +294,25 @@ impl PartialFilm {
         if parts == 0 || part >= parts {
             return Err(bad(&format!("invalid part {part}/{parts}")));
         }
-        let pixels = width
-            .checked_mul(height)
-            .filter(|&p| p > 0 && p <= 65536 * 65536);
+        // Every header field is checked before it sizes or scales anything: the part count
+        // sizes the merge, spp bounds the counts, the exposure scales the image.
+        facette_bsdf::limits::PARTS
+            .check(parts as u64)
+            .map_err(|e| bad(&e.to_string()))?;
+        if spp == 0
+            || facette_bsdf::limits::SAMPLES_PER_PIXEL
+                .check(spp as u64)
+                .is_err()
+        {
+            return Err(bad(&format!("invalid spp {spp}")));
+        }
+        facette_bsdf::limits::check_exposure(exposure)
+            .map_err(|m| bad(&format!("exposure: {m}")))?;
+        let pixels = facette_bsdf::limits::FILM_PIXELS
+            .check_product(&[width as u64, height as u64])
+            .ok()
+            .map(|p| p as usize)
+            .filter(|&p| p > 0 && width <= 65536 && height <= 65536);
         let Some(pixels) = pixels else {
             return Err(bad(&format!("invalid image size {width}×{height}")));
         };
@@ -304,6 +333,12 @@ impl PartialFilm {
                 film.sq_sums[i][c] = f64::from_bits(u64_(take(8)));
             }
             film.counts[i] = u32_(take(4));
+            if film.counts[i] > spp {
+                return Err(bad(&format!(
+                    "pixel {i} counts {} samples, more than the render's {spp} spp",
+                    film.counts[i]
+                )));
+            }
             if !film.sums[i]
                 .iter()
                 .chain(&film.sq_sums[i])

@@ -184,6 +184,13 @@ fn render_in_pool(
     if spp == 0 {
         return Err("spp must be at least 1".into());
     }
+    // Sizes are checked before anything is allocated or counted (limits.rs).
+    facette_bsdf::limits::SAMPLES_PER_PIXEL
+        .check_usize(spp)
+        .and_then(|_| {
+            facette_bsdf::limits::RENDER_SAMPLES.check_product(&[w as u64, h as u64, spp as u64])
+        })
+        .map_err(|e| e.to_string())?;
     let (part, parts) = opts.part.unwrap_or((0, 1));
     if parts == 0 || part >= parts {
         return Err(format!(
@@ -201,9 +208,9 @@ fn render_in_pool(
         .collect();
     let mut film = Film::new(w, h);
     let start = Instant::now();
-    let deadline = opts
-        .time_limit
-        .map(|s| start + Duration::from_secs_f64(s.max(0.0)));
+    let deadline = opts.time_limit.map(|s| {
+        start + Duration::from_secs_f64(s.clamp(0.0, facette_bsdf::limits::TIME_LIMIT_SECONDS))
+    });
     let done = AtomicU64::new(0);
     let stop = AtomicBool::new(false);
     // Whether to stop now. The time limit never cuts the first pass, so that every pixel

@@ -284,7 +284,7 @@ fn ply_errors_name_file_and_line() {
         matches!(e.root(), GeometryError::Malformed { format: "PLY", .. }),
         "{msg}"
     );
-    assert!(msg.contains("Line 16"), "{msg}");
+    assert!(msg.contains("parse.ply:16:"), "{msg}");
     // Truncated binary file.
     let mut short = binary_ply(false, |_| {});
     short.truncate(short.len() - 6);

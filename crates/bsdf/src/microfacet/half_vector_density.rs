@@ -24,6 +24,9 @@ pub enum HalfVectorDensity {
     Phong { n: f64 },
 }
 
+/// The narrowest RMS slope used (a narrower `alpha` is widened to it).
+pub const MIN_SLOPE: f64 = 1e-4;
+
 impl HalfVectorDensity {
     pub const NAMES: &'static [&'static str] = &["ward", "beckmann", "phong"];
 
@@ -31,11 +34,13 @@ impl HalfVectorDensity {
     /// the exponent `n` for Phong.
     pub fn new(name: &str, roughness: f64) -> ParamResult<Self> {
         match name {
+            // Widths below MIN_SLOPE are taken as MIN_SLOPE: m² of a subnormal width is 0
+            // and the density 0/0 (the microfacet recipes widen below 1e-4 the same way).
             "ward" => Ok(HalfVectorDensity::Ward {
-                m: check_alpha("alpha", roughness)?,
+                m: check_alpha("alpha", roughness)?.max(MIN_SLOPE),
             }),
             "beckmann" => Ok(HalfVectorDensity::Beckmann {
-                m: check_alpha("alpha", roughness)?,
+                m: check_alpha("alpha", roughness)?.max(MIN_SLOPE),
             }),
             "phong" => Ok(HalfVectorDensity::Phong {
                 n: check_range("exponent", roughness, 0.0, 1e7, Bounds::Closed)?,

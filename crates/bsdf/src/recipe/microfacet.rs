@@ -12,7 +12,7 @@
 //! | `sampling` | `visible`, `distribution` | `visible` |
 
 use super::params::{choice, Params};
-use crate::checks::check_alpha_or_smooth;
+use crate::checks::{check_alpha, check_alpha_or_smooth};
 use crate::error::{ParamError, ParamResult};
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::{
@@ -41,8 +41,16 @@ pub fn parse_distribution(p: &Params, allow_smooth: bool) -> ParamResult<Option<
     let ndf = match name {
         "beckmann" | "ggx" => {
             let (ax, ay) = match (p.f64("alpha")?, p.f64("alpha_u")?, p.f64("alpha_v")?) {
-                (Some(a), None, None) => (a, a),
-                (None, Some(u), Some(v)) => (u, v),
+                (Some(a), None, None) => {
+                    check_alpha_or_smooth("alpha", a)?;
+                    (a, a)
+                }
+                // Each width is checked under the key the user wrote. Anisotropic widths
+                // are positive: a smooth surface is written `alpha = 0`, and a zero along
+                // one axis only would be silently widened.
+                (None, Some(u), Some(v)) => {
+                    (check_alpha("alpha_u", u)?, check_alpha("alpha_v", v)?)
+                }
                 (None, None, None) => {
                     return Err(ParamError::MissingKey {
                         key: "alpha (or alpha_u and alpha_v)".into(),
@@ -55,10 +63,8 @@ pub fn parse_distribution(p: &Params, allow_smooth: bool) -> ParamResult<Option<
                     ))
                 }
             };
-            // The one range check of a table's widths: the constructors below take them as
-            // checked.
-            check_alpha_or_smooth("alpha", ax)?;
-            check_alpha_or_smooth("alpha", ay)?;
+            // The range check above is the one of a table's widths: the constructors below
+            // take them as checked.
             if ax < SMOOTH_ALPHA && ay < SMOOTH_ALPHA {
                 if g1.is_some() {
                     return Err(ParamError::Invalid(

@@ -88,6 +88,24 @@ impl<'a> Params<'a> {
         }
     }
 
+    /// A count that sizes a table or a loop (`samples`, `table_samples`, `resolution`):
+    /// a non-negative integer within [`crate::limits::RECIPE_COUNT`], checked before it
+    /// is used (10^12 samples would never finish).
+    pub fn count(&self, key: &str) -> ParamResult<Option<usize>> {
+        let v = self.usize(key)?;
+        if let Some(n) = v {
+            let max = crate::limits::RECIPE_COUNT.max;
+            if n as u64 > max {
+                return Err(ParamError::OutOfRange {
+                    name: key.into(),
+                    value: n as f64,
+                    expected: format!("{key} <= {max} ({})", crate::limits::RECIPE_COUNT.lift),
+                });
+            }
+        }
+        Ok(v)
+    }
+
     pub fn bool(&self, key: &str) -> ParamResult<Option<bool>> {
         match self.take(key) {
             None => Ok(None),

@@ -263,13 +263,26 @@ pub fn write_image(
     exposure_stops: f64,
 ) -> Result<(), ImageError> {
     let path = path.as_ref();
-    if !exposure_stops.is_finite() {
-        return Err(ImageError::InvalidData {
-            path: path.to_path_buf(),
-            reason: format!("exposure must be a finite number of stops, got {exposure_stops}"),
-        });
-    }
+    let invalid = |reason: String| ImageError::InvalidData {
+        path: path.to_path_buf(),
+        reason,
+    };
+    facette_bsdf::limits::check_exposure(exposure_stops)
+        .map_err(|m| invalid(format!("exposure: {m}")))?;
     let scale = exposure_stops.exp2();
+    // An exposure that would turn a finite pixel into +Inf is refused, naming the pixel,
+    // instead of writing an image of infinities (checked before anything is written).
+    if let Some((k, v)) = image.data().iter().enumerate().find_map(|(k, p)| {
+        p.iter()
+            .find(|v| v.is_finite() && !((**v as f64 * scale) as f32).is_finite())
+            .map(|v| (k, *v))
+    }) {
+        return Err(invalid(format!(
+            "exposure {exposure_stops} stops makes pixel ({}, {}) = {v:e} overflow a 32-bit float; lower the exposure",
+            k % image.width().max(1),
+            k / image.width().max(1)
+        )));
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());

@@ -27,6 +27,7 @@
 
 use crate::error::{ParamError, ParamResult};
 use crate::fresnel::fresnel_dielectric;
+use crate::limits;
 use crate::math::rng::{mix_seed, Pcg32, RandomSource};
 use crate::math::warp::hammersley;
 use crate::math::{fmt_num, spherical_direction, Vec3, PI};
@@ -252,11 +253,33 @@ impl BodyTable {
                 s("model")?
             )));
         }
-        let n_theta = f("n_theta")? as usize;
-        let n_phi = f("n_phi")? as usize;
-        if n_theta < 2 || n_phi < 2 || n_theta > 100_000 || n_phi > 100_000 {
-            return Err(bad(format!("implausible grid {n_theta} × {n_phi}")));
+        let count_of = |k: &str| -> Result<usize, TableError> {
+            match h.get(k) {
+                Some(toml::Value::Integer(x)) if *x >= 0 => Ok(*x as usize),
+                _ => Err(bad(format!("header: `{k}` must be a whole number ≥ 0"))),
+            }
+        };
+        let grid = TableGrid {
+            ni: f("ni")?,
+            distribution: s("distribution")?,
+            masking: s("masking")?,
+            step_deg: f("step_deg")?,
+            n_theta: count_of("n_theta")?,
+            n_phi: count_of("n_phi")?,
+            samples: count_of("samples")?,
+        };
+        grid.validate().map_err(|m| bad(format!("header: {m}")))?;
+        let (max_stderr, mean_stderr) = (f("max_stderr")?, f("mean_stderr")?);
+        if !(max_stderr >= 0.0
+            && max_stderr.is_finite()
+            && mean_stderr >= 0.0
+            && mean_stderr <= max_stderr)
+        {
+            return Err(bad(format!(
+                "header: max_stderr = {max_stderr}, mean_stderr = {mean_stderr} must be finite with 0 ≤ mean ≤ max"
+            )));
         }
+        let (n_theta, n_phi) = (grid.n_theta, grid.n_phi);
         let count = n_theta * n_theta * n_phi;
         let data_bytes = &payload[4 + hlen..];
         if data_bytes.len() != 8 * count {
@@ -274,15 +297,15 @@ impl BodyTable {
             return Err(bad("table contains negative or non-finite values".into()));
         }
         Ok(BodyTable {
-            ni: f("ni")?,
-            distribution: s("distribution")?,
-            masking: s("masking")?,
-            step_deg: f("step_deg")?,
+            ni: grid.ni,
+            distribution: grid.distribution,
+            masking: grid.masking,
+            step_deg: grid.step_deg,
             n_theta,
             n_phi,
-            samples: f("samples")? as usize,
-            max_stderr: f("max_stderr")?,
-            mean_stderr: f("mean_stderr")?,
+            samples: grid.samples,
+            max_stderr,
+            mean_stderr,
             data,
         })
     }
@@ -299,7 +322,10 @@ impl BodyTable {
 
     /// Writes the table atomically (temporary file in the same directory, then rename).
     pub fn save(&self, path: &std::path::Path) -> Result<(), TableError> {
-        write_atomically(path, &self.to_bytes()).map_err(|e| TableError::Io {
+        let bytes = self.to_bytes();
+        // Never write a file the loader would refuse (`facette merge` of corrupt parts).
+        Self::from_bytes(&bytes, &path.display().to_string())?;
+        write_atomically(path, &bytes).map_err(|e| TableError::Io {
             path: path.display().to_string(),
             source: e,
         })
@@ -317,6 +343,52 @@ pub(crate) struct TableGrid {
     pub n_phi: usize,
     /// Microfacets per entry actually used.
     pub samples: usize,
+}
+
+impl TableGrid {
+    /// Checks every field a file gives: `ni` a valid index, a finite step that divides 90°,
+    /// the grid sizes that step implies (n_θ = 90/step + 1, n_φ = 2·90/step + 1) within
+    /// [`limits::TABLE_ENTRIES`], and at least 8 samples. A loader accepts only what
+    /// [`compute_rows`] could have made, so lookups never meet a NaN step or a grid that
+    /// does not match it.
+    pub(crate) fn validate(&self) -> Result<(), String> {
+        crate::checks::check_ior(self.ni).map_err(|e| e.to_string().replace("`ior`", "`ni`"))?;
+        let intervals = check_step(self.step_deg)?;
+        let (n_theta, n_phi) = (intervals + 1, 2 * intervals + 1);
+        if (self.n_theta, self.n_phi) != (n_theta, n_phi) {
+            return Err(format!(
+                "grid {} × {} does not match step_deg = {}: that step gives n_theta = {n_theta}, n_phi = {n_phi}",
+                self.n_theta, self.n_phi, self.step_deg
+            ));
+        }
+        if self.samples < 8 {
+            return Err(format!(
+                "samples = {} (a table uses at least 8)",
+                self.samples
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The number of grid intervals over 90° for a step of `step_deg` degrees: the step must
+/// be finite, divide 90°, and give a grid within [`limits::TABLE_ENTRIES`].
+pub(crate) fn check_step(step_deg: f64) -> Result<usize, String> {
+    let intervals = (90.0 / step_deg).round();
+    if !(step_deg > 0.0 && step_deg <= 90.0 && step_deg.is_finite())
+        || (intervals * step_deg - 90.0).abs() > 1e-9
+        || intervals < 1.0
+    {
+        return Err(format!(
+            "step = {step_deg}°: the grid step must divide 90° (e.g. 1, 2, 2.5, 5, 10)"
+        ));
+    }
+    // Checked before the grid is allocated: a 0.01° step means 1.5·10^12 entries.
+    let n_theta = intervals as u64 + 1;
+    limits::TABLE_ENTRIES
+        .check_product(&[n_theta, n_theta, 2 * intervals as u64 + 1])
+        .map_err(|e| format!("step = {step_deg}°: {e}"))?;
+    Ok(intervals as usize)
 }
 
 /// One θ_i row: entries (θ_o index ≥ θ_i index, φ index, value, standard error).
@@ -345,12 +417,7 @@ pub(crate) fn compute_rows(
                 .into(),
         ));
     }
-    let intervals = (90.0 / step_deg).round();
-    if !(step_deg > 0.0) || (intervals * step_deg - 90.0).abs() > 1e-9 || intervals < 1.0 {
-        return Err(ParamError::Invalid(format!(
-            "step = {step_deg}°: the grid step must divide 90° (e.g. 1, 2, 2.5, 5, 10)"
-        )));
-    }
+    let intervals = check_step(step_deg).map_err(ParamError::Invalid)? as f64;
     if samples < 8 {
         return Err(ParamError::OutOfRange {
             name: "samples".into(),

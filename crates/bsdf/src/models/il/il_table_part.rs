@@ -19,6 +19,7 @@
 
 use super::il_table::{compute_rows, BodyTable, TableError, TableGrid, TableRow};
 use crate::error::ParamResult;
+use crate::limits;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use std::path::Path;
 
@@ -140,25 +141,40 @@ impl TablePart {
         if text("model")? != "il-body-part" {
             return Err(bad("not an IL body table part".into()));
         }
+        // Counts are whole numbers in the header; a float or a negative number is refused
+        // rather than truncated.
+        let count = |k: &str| -> Result<u64, TableError> {
+            match h.get(k) {
+                Some(toml::Value::Integer(i)) if *i >= 0 => Ok(*i as u64),
+                _ => Err(bad(format!("header: `{k}` must be a whole number ≥ 0"))),
+            }
+        };
         let grid = TableGrid {
             ni: num("ni")?,
             distribution: text("distribution")?,
             masking: text("masking")?,
             step_deg: num("step_deg")?,
-            n_theta: num("n_theta")? as usize,
-            n_phi: num("n_phi")? as usize,
-            samples: num("samples")? as usize,
+            n_theta: count("n_theta")? as usize,
+            n_phi: count("n_phi")? as usize,
+            samples: count("samples")? as usize,
         };
-        let (part, parts) = (num("part")? as u32, num("parts")? as u32);
-        if parts == 0 || part >= parts || grid.n_theta < 2 || grid.n_phi < 2 {
-            return Err(bad("inconsistent header".into()));
+        grid.validate().map_err(|m| bad(format!("header: {m}")))?;
+        let (part, parts) = (count("part")?, count("parts")?);
+        if parts == 0 || part >= parts {
+            return Err(bad(format!(
+                "header: part {part} of {parts}: need 0 ≤ part < parts"
+            )));
         }
+        limits::PARTS
+            .check(parts)
+            .map_err(|e| bad(format!("header: {e}")))?;
+        let (part, parts) = (part as u32, parts as u32);
         let n_rows = u32_(take(4)?) as usize;
         let mut rows = Vec::with_capacity(n_rows.min(grid.n_theta));
         for _ in 0..n_rows {
             let theta_i = u32_(take(4)?) as usize;
             let n = u32_(take(4)?) as usize;
-            if theta_i >= grid.n_theta || n > grid.n_theta * grid.n_phi {
+            if theta_i >= grid.n_theta || n > (grid.n_theta - theta_i) * grid.n_phi {
                 return Err(bad(format!("row {theta_i} is outside the grid")));
             }
             let mut entries = Vec::with_capacity(n);
@@ -167,9 +183,12 @@ impl TablePart {
                 let ph = u32_(take(4)?) as usize;
                 let v = f64::from_le_bytes(take(8)?.try_into().expect("8 bytes"));
                 let se = f64::from_le_bytes(take(8)?.try_into().expect("8 bytes"));
-                if to >= grid.n_theta || ph >= grid.n_phi || !v.is_finite() || !se.is_finite() {
+                // The table's own loader refuses negative values: a part that holds one
+                // would merge into a table that cannot be read back (found by the fuzzer).
+                let valid = |x: f64| x.is_finite() && x >= 0.0;
+                if to >= grid.n_theta || ph >= grid.n_phi || !valid(v) || !valid(se) {
                     return Err(bad(format!(
-                        "row {theta_i}: an entry is outside the grid or not finite"
+                        "row {theta_i}: an entry is outside the grid, negative or not finite"
                     )));
                 }
                 entries.push((to, ph, v, se));
@@ -198,7 +217,10 @@ impl TablePart {
 
     /// Writes the part atomically (temporary file, then rename).
     pub fn save(&self, path: &Path) -> Result<(), TableError> {
-        write_atomically(path, &self.to_bytes()).map_err(|e| TableError::Io {
+        let bytes = self.to_bytes();
+        // Never write a file the loader would refuse.
+        Self::from_bytes(&bytes, &path.display().to_string())?;
+        write_atomically(path, &bytes).map_err(|e| TableError::Io {
             path: path.display().to_string(),
             source: e,
         })
@@ -210,6 +232,7 @@ impl TablePart {
 pub fn merge_table_parts(parts: &[TablePart]) -> Result<BodyTable, String> {
     let first = parts.first().ok_or("no parts given")?;
     let n = first.parts;
+    // `n` was checked against `limits::PARTS` when the part was loaded.
     let mut seen = vec![None::<usize>; n as usize];
     for (k, p) in parts.iter().enumerate() {
         if p.parts != n {

@@ -32,7 +32,7 @@ pub(super) fn parse_lambert(p: &Params) -> ParamResult<MaterialRecipe> {
 
 /// `evaluation` and `samples` keys of models with a microfacet integral.
 pub fn parse_evaluation(p: &Params, default_samples: usize) -> ParamResult<IntegralEvaluation> {
-    let samples = p.usize("samples")?;
+    let samples = p.count("samples")?;
     match p.str("evaluation")?.unwrap_or("quadrature") {
         "stochastic" => {
             if samples.is_some() {

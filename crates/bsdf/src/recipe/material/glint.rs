@@ -188,7 +188,7 @@ pub fn parse_glint(
     }
     let (footprint_center, footprint_size) = parse_footprint(p)?;
     let masking = MaskingMode::parse(p.str("masking")?.unwrap_or("exact"))?;
-    let masking_lobes = p.usize("masking_lobes")?.unwrap_or(DEFAULT_MASKING_LOBES);
+    let masking_lobes = p.count("masking_lobes")?.unwrap_or(DEFAULT_MASKING_LOBES);
     let reference = match p.str("evaluation")?.unwrap_or("patch") {
         "patch" => false,
         "reference" => true,
@@ -230,7 +230,7 @@ fn parse_map(
 ) -> ParamResult<(NormalMap, String)> {
     let file = p.str("normal_map")?;
     let kind = p.str("generate")?;
-    let resolution = p.usize("resolution")?;
+    let resolution = p.count("resolution")?;
     let seed = p.usize("seed")?;
     let encoding = p
         .str("normal_encoding")?

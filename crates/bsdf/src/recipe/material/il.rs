@@ -46,7 +46,7 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
         None => NormalSampling::Visible,
         Some(s) => NormalSampling::parse(s)?,
     };
-    let samples = p.usize("samples")?;
+    let samples = p.count("samples")?;
     let table_path = p.str("table")?;
     let evaluation = match p.str("evaluation")?.unwrap_or(if table_path.is_some() {
         "table"

@@ -3,7 +3,7 @@
 
 use super::{keys, MaterialRecipe};
 use crate::checks::check_ior;
-use crate::error::ParamResult;
+use crate::error::{ParamError, ParamResult};
 use crate::fresnel::Fresnel;
 use crate::math::spectrum::Spectrum;
 use crate::microfacet::half_vector_density::HalfVectorDensity;
@@ -22,6 +22,14 @@ pub(super) const KELEMEN_KEYS: &[&str] = &[
 
 pub(super) fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let name = p.str("distribution")?.unwrap_or("ward");
+    // An unknown name is reported as such, not as the missing width it would need.
+    if !HalfVectorDensity::NAMES.contains(&name) {
+        return Err(ParamError::UnknownChoice {
+            what: "distribution".into(),
+            given: name.into(),
+            valid: HalfVectorDensity::NAMES.join(", "),
+        });
+    }
     let rough = match name {
         "phong" => p.required_f64("exponent")?,
         _ => p.required_f64("alpha")?,
@@ -29,7 +37,7 @@ pub(super) fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let density = HalfVectorDensity::new(name, rough)?;
     let ior = check_ior(p.f64_or("ior", 1.5)?)?;
     let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
-    let samples = p.usize("table_samples")?.unwrap_or(16384);
+    let samples = p.count("table_samples")?.unwrap_or(16384);
     p.finish(&keys(KELEMEN_KEYS, false))?;
     Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::new(
         density,

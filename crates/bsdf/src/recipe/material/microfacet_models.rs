@@ -220,6 +220,15 @@ pub(super) fn parse_dielectric(p: &Params) -> ParamResult<MaterialRecipe> {
         100.0,
         Bounds::OpenClosed,
     )?;
+    // The model's own range is on the ratio; it is reported under the keys the user wrote.
+    let eta = ior / ext;
+    if !(1e-3..=1e3).contains(&eta) {
+        return Err(ParamError::OutOfRange {
+            name: "ior / ext_ior".into(),
+            value: eta,
+            expected: "1e-3 <= ior / ext_ior <= 1e3".into(),
+        });
+    }
     let energy = parse_energy(p)?;
     let masking = parse_masking_for(p, ndf.as_ref(), energy)?;
     let (sampling, widened) = match p.str("sampling")?.unwrap_or("visible") {

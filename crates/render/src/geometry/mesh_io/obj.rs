@@ -33,6 +33,22 @@ fn parse_obj(
         ignore_points: true,
         ignore_lines: true,
     };
+    if let Some((line, what)) = face_index_without_data(bytes) {
+        return Err((
+            GeometryError::Malformed {
+                format: "OBJ",
+                message: format!(
+                    "a face gives {what} indices, but the file has no `{}` lines",
+                    if what == "texture coordinate" {
+                        "vt"
+                    } else {
+                        "vn"
+                    }
+                ),
+            },
+            Some(line),
+        ));
+    }
     let mut reader = LineCounter::new(bytes);
     let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
@@ -149,6 +165,38 @@ fn locate_tobj_error(
         },
         Some(line.max(1)),
     )
+}
+
+/// The first face (1-based line) that gives `v/vt` or `v/vt/vn` indices for a kind of data
+/// the file never declares: `tobj` would silently drop them (or index nothing).
+fn face_index_without_data(bytes: &[u8]) -> Option<(usize, &'static str)> {
+    let text = String::from_utf8_lossy(bytes);
+    let has = |kw: &str| {
+        text.lines()
+            .any(|l| l.split_whitespace().next() == Some(kw))
+    };
+    let (has_vt, has_vn) = (has("vt"), has("vn"));
+    if has_vt && has_vn {
+        return None;
+    }
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("f") {
+            continue;
+        }
+        for w in words {
+            // `v`, `v/vt`, `v//vn` or `v/vt/vn`.
+            let mut parts = w.split('/').skip(1);
+            let (vt, vn) = (parts.next(), parts.next());
+            if !has_vt && vt.is_some_and(|t| !t.is_empty()) {
+                return Some((k + 1, "texture coordinate"));
+            }
+            if !has_vn && vn.is_some_and(|n| !n.is_empty()) {
+                return Some((k + 1, "normal"));
+            }
+        }
+    }
+    None
 }
 
 /// A `v`/`vn`/`vt` line with a non-finite value: its line, its 0-based ordinal among

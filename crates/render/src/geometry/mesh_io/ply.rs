@@ -10,6 +10,7 @@
 use crate::geometry::error::{GeometryError, GeometryResult};
 use crate::geometry::mesh_data::MeshData;
 use crate::geometry::{Vec2, Vec3};
+use facette_bsdf::limits;
 use ply_rs::parser::Parser;
 use ply_rs::ply::{Encoding, Header, Property, PropertyAccess};
 use std::path::Path;
@@ -147,10 +148,28 @@ fn parse_ply(bytes: &[u8]) -> Result<MeshData, (GeometryError, Option<usize>)> {
             None,
         )
     };
+    // ply-rs panics on numbers it cannot hold and allocates one record per declared
+    // element before reading it: the header is validated first, against the file's size.
+    check_header(bytes).map_err(|(m, line)| {
+        (
+            GeometryError::Malformed {
+                format: "PLY",
+                message: m,
+            },
+            line,
+        )
+    })?;
     let parser = Parser::<Record>::new();
-    let ply = parser
-        .read_ply(&mut &bytes[..])
-        .map_err(|e| malformed(e.to_string()))?;
+    let ply = parser.read_ply(&mut &bytes[..]).map_err(|e| {
+        let (message, line) = ply_rs_message(&e.to_string());
+        (
+            GeometryError::Malformed {
+                format: "PLY",
+                message,
+            },
+            line,
+        )
+    })?;
     let lines = AsciiLines::new(bytes, &ply.header);
     let line_of = |element: &str, k: usize| lines.as_ref().and_then(|l| l.line(element, k));
 
@@ -251,6 +270,159 @@ fn parse_ply(bytes: &[u8]) -> Result<MeshData, (GeometryError, Option<usize>)> {
     Ok(data)
 }
 
+/// ply-rs's messages end in a Debug dump of its parser state (and say "Couln't"): only the
+/// first line is kept, in plain words.
+/// The line ply-rs names ("Line 12: …") is returned apart, for the file:line of the error.
+fn ply_rs_message(m: &str) -> (String, Option<usize>) {
+    let mut first = m.lines().next().unwrap_or(m).trim();
+    let mut line = None;
+    if let Some((n, rest)) = first.strip_prefix("Line ").and_then(|r| r.split_once(": ")) {
+        if let Ok(n) = n.parse::<usize>() {
+            line = Some(n);
+            first = rest;
+        }
+    }
+    let first = first
+        .replace("Couln't", "could not")
+        .replace("Couldn't", "could not");
+    let value = m
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Value: "))
+        .map(|v| format!(" (value {v})"))
+        .unwrap_or_default();
+    (format!("{first}{value}"), line)
+}
+
+/// Bytes of a scalar type of the header, `None` for an unknown name.
+fn scalar_bytes(name: &str) -> Option<u64> {
+    Some(match name {
+        "char" | "int8" | "uchar" | "uint8" => 1,
+        "short" | "int16" | "ushort" | "uint16" => 2,
+        "int" | "int32" | "uint" | "uint32" | "float" | "float32" => 4,
+        "double" | "float64" => 8,
+        _ => return None,
+    })
+}
+
+/// Validates the header before ply-rs reads the file: the magic line, one known format
+/// with a plausible version, known property types, element counts that are numbers within
+/// [`limits::MESH_ELEMENTS`] and that the rest of the file can hold (each element takes at
+/// least one byte per property in binary, two characters per property in ASCII), and no
+/// element that declares a count but no properties (ply-rs would make one empty record per
+/// count without reading anything). Errors carry the header line.
+fn check_header(bytes: &[u8]) -> Result<(), (String, Option<usize>)> {
+    let Some(end) = find(bytes, b"end_header") else {
+        return Err((
+            "no `end_header` line: not a PLY file, or a truncated header".into(),
+            None,
+        ));
+    };
+    let header = std::str::from_utf8(&bytes[..end])
+        .map_err(|_| ("the header is not ASCII text".to_string(), None))?;
+    let payload = (bytes.len() - end) as u64;
+    let mut binary = None;
+    // (name, count, minimum binary bytes per element, properties, line) of each element.
+    let mut elements: Vec<(String, u64, u64, u64, usize)> = Vec::new();
+    for (k, line) in header.lines().enumerate() {
+        let n = k + 1;
+        let err = |m: String| (m, Some(n));
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.first().copied() {
+            _ if n == 1 => {
+                if line.trim_end() != "ply" {
+                    return Err(err("the first line must be `ply`: not a PLY file".into()));
+                }
+            }
+            None | Some("comment") | Some("obj_info") => {}
+            Some("format") => {
+                let version_ok = words.get(2).is_some_and(|v| {
+                    v.split_once('.').is_some_and(|(a, b)| {
+                        a.parse::<u16>().is_ok() && b.parse::<u8>().is_ok()
+                    })
+                });
+                binary = match words.get(1).copied() {
+                    Some("ascii") => Some(false),
+                    Some("binary_little_endian") | Some("binary_big_endian") => Some(true),
+                    other => {
+                        return Err(err(format!(
+                            "unknown format `{}`; valid: ascii, binary_little_endian, binary_big_endian",
+                            other.unwrap_or("")
+                        )))
+                    }
+                };
+                if !version_ok || words.len() != 3 {
+                    return Err(err(format!("`{}`: expected `format <encoding> 1.0`", line.trim())));
+                }
+            }
+            Some("element") => {
+                let (Some(name), Some(count), 3) = (words.get(1), words.get(2), words.len()) else {
+                    return Err(err(format!("`{}`: expected `element <name> <count>`", line.trim())));
+                };
+                let count: u64 = count.parse().map_err(|_| {
+                    err(format!("element `{name}`: the count `{count}` is not a whole number below 2^64"))
+                })?;
+                limits::MESH_ELEMENTS
+                    .check(count)
+                    .map_err(|e| err(format!("element `{name}`: {e}")))?;
+                elements.push((name.to_string(), count, 0, 0, n));
+            }
+            Some("property") => {
+                let Some(last) = elements.last_mut() else {
+                    return Err(err("a property before any element".into()));
+                };
+                let (size, len) = match words.get(1).copied() {
+                    Some("list") => (
+                        words.get(2).and_then(|t| scalar_bytes(t)).zip(words.get(3).and_then(|t| scalar_bytes(t))).map(|(c, _)| c),
+                        5,
+                    ),
+                    Some(t) => (scalar_bytes(t), 3),
+                    None => (None, 3),
+                };
+                if words.len() != len || size.is_none() {
+                    return Err(err(format!(
+                        "`{}`: expected `property <type> <name>` or `property list <count type> <type> <name>`; types: char, uchar, short, ushort, int, uint, float, double (or int8 … float64)",
+                        line.trim()
+                    )));
+                }
+                last.2 += size.unwrap_or(1);
+                last.3 += 1;
+            }
+            Some(other) => {
+                return Err(err(format!(
+                    "unknown header keyword `{other}`; valid: format, element, property, comment, obj_info, end_header"
+                )))
+            }
+        }
+    }
+    let Some(binary) = binary else {
+        return Err(("the header has no `format` line".into(), None));
+    };
+    let mut needed: u64 = 0;
+    for (name, count, bytes_each, properties, line) in &elements {
+        if *properties == 0 && *count > 0 {
+            return Err((
+                format!("element `{name}` declares {count} elements but no properties"),
+                Some(*line),
+            ));
+        }
+        // ASCII: at least one digit and one separator per property.
+        let each = if binary { *bytes_each } else { 2 * properties };
+        needed = count
+            .checked_mul(each)
+            .and_then(|b| needed.checked_add(b))
+            .unwrap_or(u64::MAX);
+        if needed > payload {
+            return Err((
+                format!(
+                    "element `{name}` declares {count} elements, more than the {payload} bytes after the header can hold"
+                ),
+                Some(*line),
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,9 +463,10 @@ mod tests {
         // tests/geometry_mesh_io.rs).
         for bad in ["1 nan 0 1 1", "1 one 0 1 1"] {
             let garbage = QUAD.replace("1 1 0 1 1", bad);
-            let (e, _) = parse_ply(garbage.as_bytes()).unwrap_err();
+            let (e, line) = parse_ply(garbage.as_bytes()).unwrap_err();
             assert!(matches!(e, GeometryError::Malformed { .. }), "{e}");
-            assert!(e.to_string().contains("Line 15"), "{e}");
+            assert_eq!(line, Some(15), "{e}");
+            assert!(!e.to_string().contains("Error:"), "no Debug dump: {e}");
         }
         let (e, _) = parse_ply(b"not a ply file\n").unwrap_err();
         assert!(matches!(e, GeometryError::Malformed { .. }));

@@ -42,9 +42,7 @@ pub(super) fn create_environment_map(site: &LightSite) -> Result<Light, SceneErr
         }
     };
     let scale = d.scale.unwrap_or(1.0);
-    if !(scale >= 0.0 && scale.is_finite()) {
-        return Err(e("`scale` must be finite and ≥ 0".into()));
-    }
+    facette_bsdf::limits::check_radiance(scale).map_err(|m| e(format!("`scale`: {m}")))?;
     let t = parse_transform(&d.transform).map_err(e)?;
     let m = t.matrix();
     let rot = DMat3::from_cols(

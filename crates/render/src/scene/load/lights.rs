@@ -100,8 +100,9 @@ impl LightSite<'_> {
         let s = c
             .ok_or_else(|| self.err(format!("needs `{name}`")))?
             .spectrum();
-        if !s.is_finite() || s.has_negative() {
-            return Err(self.err(format!("`{name}` must be finite and ≥ 0")));
+        for c in 0..3 {
+            facette_bsdf::limits::check_radiance(s[c])
+                .map_err(|m| self.err(format!("`{name}`: {m}")))?;
         }
         Ok(s)
     }

@@ -14,6 +14,7 @@ mod lights;
 mod materials;
 mod objects;
 mod settings;
+mod toml_errors;
 mod values;
 
 pub use values::parse_transform;
@@ -28,8 +29,12 @@ use std::path::{Path, PathBuf};
 /// Loads a TOML scene from its text; `path` names it in errors and anchors relative paths.
 pub fn load_scene_str(source: &str, path: &Path) -> Result<Scene, SceneError> {
     let spans = Spans::Text { file: path, source };
-    let desc: SceneDesc =
-        toml::from_str(source).map_err(|e| spans.err(e.span(), e.message().to_string()))?;
+    let desc: SceneDesc = toml::from_str(source).map_err(|e| {
+        spans.err(
+            e.span(),
+            toml_errors::rewrite(e.message(), source, e.span()),
+        )
+    })?;
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     build_scene(spans, base_dir, desc, fnv1a(source.as_bytes()))
 }

@@ -154,8 +154,9 @@ fn create_emission(
         None => None,
         Some(c) => {
             let s = c.spectrum();
-            if !s.is_finite() || s.has_negative() {
-                return Err(e("`emission` must be finite and ≥ 0".into()));
+            for c in 0..3 {
+                facette_bsdf::limits::check_radiance(s[c])
+                    .map_err(|m| e(format!("`emission`: {m}")))?;
             }
             Some((s, o.two_sided))
         }

@@ -6,6 +6,7 @@ use crate::kernel::Kernel;
 use crate::sampler::SamplerKind;
 use crate::scene::description::{FilmDesc, IntegratorDesc};
 use crate::scene::{FilmSettings, IntegratorSettings, SceneError};
+use facette_bsdf::limits;
 use toml::Spanned;
 
 /// The film of the description (defaults where there is no `[film]`), validated.
@@ -15,18 +16,30 @@ pub(super) fn create_film(
 ) -> Result<FilmSettings, SceneError> {
     let film_span = desc.as_ref().map(|f| f.span());
     let f = desc.map(|f| f.into_inner()).unwrap_or_default();
-    if f.width == 0 || f.height == 0 || f.width > 65536 || f.height > 65536 {
+    if f.width == 0 || f.height == 0 {
         return Err(ctx.err(
             film_span.clone(),
-            format!("film size {}×{} is outside 1…65536", f.width, f.height),
+            format!(
+                "film size {}×{}: width and height must be at least 1",
+                f.width, f.height
+            ),
         ));
+    }
+    // Checked before anything is allocated: a 65536² film would need 220 GB.
+    let size = limits::FILM_SIDE
+        .check_usize(f.width.max(f.height))
+        .and_then(|_| limits::FILM_PIXELS.check_product(&[f.width as u64, f.height as u64]));
+    if let Err(x) = size {
+        return Err(ctx.err(film_span.clone(), format!("film size: {x}")));
     }
     if f.spp == 0 {
         return Err(ctx.err(film_span.clone(), "`spp` must be at least 1"));
     }
-    if !f.exposure.is_finite() {
-        return Err(ctx.err(film_span.clone(), "`exposure` must be finite"));
+    if let Err(x) = limits::SAMPLES_PER_PIXEL.check_usize(f.spp) {
+        return Err(ctx.err(film_span.clone(), format!("`spp`: {x}")));
     }
+    limits::check_exposure(f.exposure)
+        .map_err(|m| ctx.err(film_span.clone(), format!("`exposure`: {m}")))?;
     let filter = match f.filter.as_str() {
         "box" => Filter::Box,
         "gaussian" => {

@@ -64,6 +64,7 @@ pub fn load_mitsuba_scene(path: &Path, defines: &[(String, String)]) -> Result<S
     let scene = Plugin::from_element(&pre.root)?;
     let mut reg = Registry::default();
     reg.add(&scene)?;
+    reg.check_references(&scene)?;
     let main_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut cx = Translator::new(reg, main_dir.clone());
     for w in &pre.warnings {

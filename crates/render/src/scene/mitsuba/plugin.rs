@@ -9,6 +9,7 @@ use super::transform::parse_transform;
 use super::values::{parse_numbers, parse_one_or_three};
 use super::xml::{Element, Pos};
 use crate::scene::SceneError;
+use facette_bsdf::limits;
 use glam::DMat4;
 use std::cell::Cell;
 use std::collections::HashMap;
@@ -108,6 +109,54 @@ impl Registry {
                 self.add(o)?;
             }
         }
+        Ok(())
+    }
+
+    /// Checks that following `<ref>`s from `root` never comes back to an object on the way
+    /// (`<bsdf type="twosided" id="a"><ref id="a"/></bsdf>` would make every translation
+    /// recurse forever) and that chains of references stay within
+    /// [`limits::XML_REF_DEPTH`]. Every object is walked once (a colour mark per id), so
+    /// references shared by many objects cost nothing more.
+    pub fn check_references(&self, root: &Rc<Plugin>) -> Result<(), SceneError> {
+        let mut done: HashMap<*const Plugin, ()> = HashMap::new();
+        let mut path: Vec<(*const Plugin, String)> = Vec::new();
+        self.walk(root, &mut done, &mut path, 0)
+    }
+
+    fn walk(
+        &self,
+        p: &Rc<Plugin>,
+        done: &mut HashMap<*const Plugin, ()>,
+        path: &mut Vec<(*const Plugin, String)>,
+        refs: usize,
+    ) -> Result<(), SceneError> {
+        let key = Rc::as_ptr(p);
+        if done.contains_key(&key) {
+            return Ok(());
+        }
+        path.push((key, p.id.clone().unwrap_or_else(|| p.describe())));
+        for prop in &p.props {
+            let (next, refs) = match &prop.value {
+                Value::Object(o) => (o.clone(), refs),
+                Value::Ref(id) => (self.get(id, &prop.pos)?, refs + 1),
+                _ => continue,
+            };
+            if let Some(at) = path.iter().position(|(k, _)| *k == Rc::as_ptr(&next)) {
+                let mut cycle: Vec<&str> = path[at..].iter().map(|(_, n)| n.as_str()).collect();
+                cycle.push(path[at].1.as_str());
+                return Err(prop.pos.err(format!(
+                    "<ref id=\"{}\">: the reference makes a cycle ({}); an object cannot contain itself",
+                    next.id.as_deref().unwrap_or(""),
+                    cycle.join(" → ")
+                )));
+            }
+            if let Err(e) = limits::XML_REF_DEPTH.check_usize(refs) {
+                return Err(prop.pos.err(e.to_string()));
+            }
+            self.walk(&next, done, path, refs)?;
+        }
+        path.pop();
+        done.insert(key, ());
         Ok(())
     }
 

@@ -14,10 +14,8 @@
 
 use super::xml::{read_xml_file, Element, Pos};
 use crate::scene::SceneError;
+use facette_bsdf::limits;
 use std::path::{Path, PathBuf};
-
-/// Deepest `<include>` nesting (Mitsuba's limit too).
-const MAX_INCLUDE_DEPTH: usize = 15;
 
 /// A scene parameter: `-D` or `<default>`.
 struct Param {
@@ -43,6 +41,14 @@ struct State {
     main_dir: PathBuf,
     /// Files being included (cycle detection).
     stack: Vec<PathBuf>,
+    /// Files included so far, all levels together: an include fan-out (4 per file, 12
+    /// levels) would otherwise read 16 million files.
+    includes: usize,
+    /// Elements kept so far, all files together (the total-work limit).
+    elements: usize,
+    /// Bytes of attribute values after substitution, all together: parameters that expand
+    /// to parameters grow exponentially.
+    expanded_bytes: usize,
 }
 
 /// Reads `path` and preprocesses it with the command-line `defines`.
@@ -76,6 +82,9 @@ pub(crate) fn preprocess(
         warnings: Vec::new(),
         main_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         stack: vec![canonical(path)],
+        includes: 0,
+        elements: 0,
+        expanded_bytes: 0,
     };
     if root.tag != "scene" {
         return Err(root.pos.err(format!(
@@ -123,6 +132,11 @@ fn upgrade_file(root: &mut Element, required: bool) -> Result<(), SceneError> {
             "could not parse the version `{v}`: expected three numbers, like 3.0.0"
         ))
     })?;
+    if version.0 > 3 {
+        return Err(root.pos.err(format!(
+            "version `{v}` is newer than the Mitsuba 3 format facette reads (versions up to 3.x.y; older files are upgraded)"
+        )));
+    }
     root.remove_attr("version");
     if version < (2, 0, 0) {
         upgrade_pre_2(root);
@@ -244,11 +258,27 @@ impl State {
             let mut v = value.clone();
             for &i in &order {
                 let key = format!("${}", self.params[i].name);
-                if v.contains(&key) {
+                let uses = v.matches(&key).count();
+                if uses > 0 {
+                    // The size of the result is checked before it is built.
+                    let grown = uses
+                        .checked_mul(self.params[i].value.len())
+                        .and_then(|g| g.checked_add(v.len()))
+                        .unwrap_or(usize::MAX);
+                    limits::XML_EXPANDED_BYTES
+                        .check_usize(grown.saturating_add(self.expanded_bytes))
+                        .map_err(|x| {
+                            e.pos.err(format!(
+                                "expanding ${} in \"{}…\": {x}",
+                                self.params[i].name,
+                                value.chars().take(40).collect::<String>()
+                            ))
+                        })?;
                     v = v.replace(&key, &self.params[i].value);
                     self.params[i].used = true;
                 }
             }
+            self.expanded_bytes += v.len();
             if let Some(at) = v.find('$') {
                 let name: String = v[at + 1..]
                     .chars()
@@ -267,6 +297,10 @@ impl State {
     fn expand(&mut self, elements: Vec<Element>, depth: usize) -> Result<Vec<Element>, SceneError> {
         let mut out = Vec::with_capacity(elements.len());
         for mut e in elements {
+            self.elements += 1;
+            limits::XML_ELEMENTS
+                .check_usize(self.elements)
+                .map_err(|x| e.pos.err(x.to_string()))?;
             self.substitute(&mut e)?;
             match e.tag.as_str() {
                 "default" => {
@@ -300,11 +334,16 @@ impl State {
 
     /// The elements an `<include>` stands for.
     fn include(&mut self, e: &Element, depth: usize) -> Result<Vec<Element>, SceneError> {
-        if depth + 1 > MAX_INCLUDE_DEPTH {
+        if depth + 1 > limits::XML_INCLUDE_DEPTH.max as usize {
             return Err(e.pos.err(format!(
-                "<include> nested deeper than {MAX_INCLUDE_DEPTH} files"
+                "<include> nested deeper than {} files",
+                limits::XML_INCLUDE_DEPTH.max
             )));
         }
+        self.includes += 1;
+        limits::XML_INCLUDES
+            .check_usize(self.includes)
+            .map_err(|x| e.pos.err(format!("<include>: {x}")))?;
         let name = e.attr("filename").unwrap_or("");
         let path = resolve(name, &e.pos, &self.main_dir).ok_or_else(|| {
             e.pos.err(format!(

@@ -3,6 +3,7 @@
 //! after `<include>`d files have been spliced into the main one.
 
 use crate::scene::SceneError;
+use facette_bsdf::limits;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -92,11 +93,19 @@ impl Element {
 /// Reads and parses an XML file; returns its root element and its text (for hashing).
 /// A missing file or malformed XML is an error naming the file (and the line).
 pub(crate) fn read_xml_file(path: &Path) -> Result<(Element, String), SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let err = |message: String| SceneError {
         file: path.to_path_buf(),
         line: None,
-        message: format!("cannot read the scene file: {e}"),
-    })?;
+        message,
+    };
+    // The size is checked before the file is read into memory.
+    if let Ok(m) = std::fs::metadata(path) {
+        limits::SCENE_FILE_BYTES
+            .check(m.len())
+            .map_err(|e| err(e.to_string()))?;
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| err(format!("cannot read the scene file: {e}")))?;
     let root = parse_xml(&text, path)?;
     Ok((root, text))
 }
@@ -109,22 +118,29 @@ pub(crate) fn parse_xml(text: &str, path: &Path) -> Result<Element, SceneError> 
         line: Some(e.pos().row as usize),
         message: format!("malformed XML: {e}"),
     })?;
-    convert(&doc, doc.root_element(), &file)
+    convert(&doc, doc.root_element(), &file, 1)
 }
 
+/// Converts `node` at nesting `depth` (the root is 1). The depth is bounded so that every
+/// later pass over the tree (preprocessing, plugins, translation, drop) recurses a bounded
+/// number of levels: 20,000 nested elements are an error, not a stack overflow.
 fn convert(
     doc: &roxmltree::Document,
     node: roxmltree::Node,
     file: &Rc<PathBuf>,
+    depth: usize,
 ) -> Result<Element, SceneError> {
     let pos = Pos {
         file: file.clone(),
         line: doc.text_pos_at(node.range().start).row as usize,
     };
+    if let Err(e) = limits::XML_DEPTH.check_usize(depth) {
+        return Err(pos.err(format!("<{}>: {e}", node.tag_name().name())));
+    }
     let mut children = Vec::new();
     for child in node.children() {
         if child.is_element() {
-            children.push(convert(doc, child, file)?);
+            children.push(convert(doc, child, file, depth + 1)?);
         } else if child.is_text() {
             let text = child.text().unwrap_or("");
             if !text.trim().is_empty() {

@@ -1,0 +1,325 @@
+//! Hostile and careless command lines (issue 17): each example of the issue gives a clear
+//! error naming the culprit and a non-zero exit — no panic, no allocation abort, no
+//! infinite pixel, no clobbered output — or, for a valid extreme, a finite result.
+
+mod common;
+
+use common::*;
+use facette_bsdf::storage::framed::Framed;
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+const SCENE: &str = r#"
+[camera]
+position = [0, 0, 4]
+target = [0, 0, 0]
+fov = 40
+
+[film]
+width = 8
+height = 6
+spp = 2
+
+[[objects]]
+shape = "sphere"
+radius = 1
+material = { type = "lambert", reflectance = 0.5 }
+
+[[lights]]
+type = "constant"
+radiance = 1.0
+"#;
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A failure that is an error message, not a panic or a signal.
+fn assert_clean_error(o: &Output, culprit: &str) {
+    let err = stderr(o);
+    assert!(
+        matches!(o.status.code(), Some(1) | Some(2)),
+        "exit {:?}: {err}",
+        o.status
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains(culprit), "expected `{culprit}` in: {err}");
+}
+
+fn scene_file(dir: &Path, text: &str) -> std::path::PathBuf {
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn render_flags_beyond_their_limits_are_errors_and_write_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = scene_file(d.path(), SCENE);
+    let out = d.path().join("x.exr");
+    for (flag, value, culprit) in [
+        ("--spp", "18446744073709551615", "--spp"),
+        ("--time-limit", "1e308", "--time-limit"),
+        ("--exposure", "5000", "--exposure"),
+        ("--threads", "100000000", "--threads"),
+    ] {
+        let o = facette(&["render", s(&scene), "-o", s(&out), flag, value], None);
+        assert_clean_error(&o, culprit);
+        assert!(!out.exists(), "{flag} {value}");
+    }
+    // A product that overflows: a valid film and spp whose product is out of bounds.
+    let big = scene_file(
+        d.path(),
+        &SCENE
+            .replace("width = 8", "width = 5000")
+            .replace("height = 6", "height = 5000"),
+    );
+    let o = facette(
+        &["render", s(&big), "-o", s(&out), "--spp", "16777216"],
+        None,
+    );
+    assert_clean_error(&o, "camera samples");
+}
+
+#[test]
+fn scene_exposure_and_film_size_the_docs_allowed_are_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("x.exr");
+    let exposure = scene_file(
+        d.path(),
+        &SCENE.replace("spp = 2", "spp = 2\nexposure = 2000"),
+    );
+    assert_clean_error(
+        &facette(&["render", s(&exposure), "-o", s(&out)], None),
+        "`exposure`",
+    );
+    let film = scene_file(
+        d.path(),
+        &SCENE
+            .replace("width = 8", "width = 65536")
+            .replace("height = 6", "height = 65536"),
+    );
+    assert_clean_error(
+        &facette(&["render", s(&film), "-o", s(&out)], None),
+        "film pixels",
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_second_interrupt_while_rendering_writes_nothing_and_leaves_no_temporary_file() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = scene_file(
+        d.path(),
+        &SCENE
+            .replace("width = 8", "width = 64")
+            .replace("height = 6", "height = 64"),
+    );
+    let out = d.path().join("twice.exr");
+    let child = Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args(["render", s(&scene), "-o", s(&out), "--spp", "1000000"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    for _ in 0..2 {
+        let killed = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    // Either the second signal came while rendering (nothing written) or during the write
+    // (the write completes): never a message that contradicts the file.
+    let entries: Vec<String> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        entries.iter().all(|n| !n.contains("tmp")),
+        "temporary file left: {entries:?}"
+    );
+    if err.contains("exiting without writing") {
+        assert!(!out.exists(), "{err}");
+    } else {
+        assert!(out.exists(), "{err}");
+    }
+}
+
+#[test]
+fn lab_counts_out_of_range_are_usage_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let o = facette(&["il-approx", "accuracy", "--samples", "0"], None);
+    assert_clean_error(&o, "--samples");
+    let p = d.path().join("p.svg");
+    let o = facette(
+        &[
+            "plot",
+            "slice",
+            "--material",
+            "{type = \"lambert\"}",
+            "--points",
+            "1000000000",
+            "-o",
+            s(&p),
+        ],
+        None,
+    );
+    assert_clean_error(&o, "--points");
+    let t = d.path().join("t.fctab");
+    let o = facette(
+        &[
+            "tabulate",
+            "--material",
+            "{type = \"il\", ni = 1.2, distribution = \"gaussian\", sigma = 0.3}",
+            "--step",
+            "0.01",
+            "-o",
+            s(&t),
+        ],
+        None,
+    );
+    assert_clean_error(&o, "table entries");
+    assert!(!p.exists() && !t.exists());
+}
+
+#[test]
+fn plot_checks_every_output_before_writing_any() {
+    let d = tempfile::tempdir().unwrap();
+    let svg = d.path().join("p.svg");
+    std::fs::write(&svg, "previous").unwrap();
+    let csv = d.path().join("no/dir/p.csv");
+    let o = facette(
+        &[
+            "plot",
+            "slice",
+            "--material",
+            "{type = \"lambert\"}",
+            "-o",
+            s(&svg),
+            "--csv",
+            s(&csv),
+        ],
+        None,
+    );
+    assert_clean_error(&o, "--csv");
+    assert_eq!(std::fs::read_to_string(&svg).unwrap(), "previous");
+}
+
+#[test]
+fn a_random_file_given_as_merl_is_refused_before_its_dimensions_are_multiplied() {
+    let d = tempfile::tempdir().unwrap();
+    let f = d.path().join("random.binary");
+    // Fixed pseudo-random bytes (an LCG), 35 MB as in the issue.
+    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+    let bytes: Vec<u8> = (0..35_000_000)
+        .map(|_| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 56) as u8
+        })
+        .collect();
+    std::fs::write(&f, &bytes).unwrap();
+    assert_clean_error(&facette(&["fit", s(&f)], None), "random.binary");
+    // The header alone, with dimensions whose product overflows.
+    let mut header = Vec::new();
+    for d in [i32::MAX, i32::MAX, 3] {
+        header.extend_from_slice(&d.to_le_bytes());
+    }
+    std::fs::write(&f, &header).unwrap();
+    assert_clean_error(&facette(&["fit", s(&f)], None), "dimensions");
+}
+
+#[test]
+fn material_errors_name_the_key_the_user_wrote() {
+    let eval = |m: &str| facette(&["eval", "--material", m], Some("10,0,20,0\n"));
+    let o = eval("{type = \"conductor\", distribution = \"ggx\", alpha_u = 0, alpha_v = 0.1}");
+    assert_clean_error(&o, "`alpha_u`");
+    let o = eval("{type = \"conductor\", distribution = \"ggx\", alpha_u = 0.1, alpha_v = 20}");
+    assert_clean_error(&o, "`alpha_v`");
+    let o = eval("{type = \"dielectric\", alpha = 0.1, ior = 0.0001, ext_ior = 50}");
+    assert_clean_error(&o, "ior / ext_ior");
+    assert!(!stderr(&o).contains("`eta`"), "{}", stderr(&o));
+    let o = eval("{type = \"kelemen\", distribution = \"x\", kd = 0.5}");
+    assert_clean_error(&o, "unknown distribution `x`");
+    // A valid extreme gives a finite result.
+    let o = eval("{type = \"kelemen\", alpha = 1e-320}");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = rows(&o);
+    assert!(r[0][4..].iter().all(|v| v.is_finite()), "{:?}", r);
+}
+
+/// Renders the two parts of `SCENE` into `dir`; returns their paths.
+fn two_parts(dir: &Path) -> Vec<std::path::PathBuf> {
+    let scene = scene_file(dir, SCENE);
+    (0..2)
+        .map(|k| {
+            let p = dir.join(format!("p{k}.fcpart"));
+            let part = format!("{k}/2");
+            let o = facette(&["render", s(&scene), "--part", &part, "-o", s(&p)], None);
+            assert!(o.status.success(), "{}", stderr(&o));
+            p
+        })
+        .collect()
+}
+
+/// A part file with `edit` applied to its payload and a valid checksum again: the
+/// corruption a CRC cannot catch (a bug, or a hand-made file).
+fn corrupt(path: &Path, edit: impl Fn(&mut Vec<u8>)) {
+    const FRAME: Framed = Framed {
+        magic: b"FCRPART1",
+        version: 3,
+        legacy_version: Some(2),
+        what: "facette partial render",
+    };
+    let bytes = std::fs::read(path).unwrap();
+    let mut payload = FRAME.unframe(&bytes).unwrap().payload.to_vec();
+    edit(&mut payload);
+    std::fs::write(path, FRAME.frame(&payload)).unwrap();
+}
+
+#[test]
+fn merge_refuses_corrupt_part_headers_without_overflow_or_huge_allocations() {
+    // Payload offsets: hash 0, seed 8, part 16, parts 20, spp 24, sampler 28, width 32,
+    // height 36, exposure 40, discarded 48, pixels from 56 (sums, squares, count).
+    let cases: [(&str, usize, Vec<u8>); 4] = [
+        (
+            "parts of a distributed job",
+            20,
+            4_000_000_000u32.to_le_bytes().to_vec(),
+        ),
+        ("exposure", 40, f64::NAN.to_le_bytes().to_vec()),
+        (
+            "more than the render's",
+            56 + 48,
+            u32::MAX.to_le_bytes().to_vec(),
+        ),
+        ("invalid image size", 32, 70_000u32.to_le_bytes().to_vec()),
+    ];
+    for (culprit, at, value) in cases {
+        let d = tempfile::tempdir().unwrap();
+        let parts = two_parts(d.path());
+        corrupt(&parts[1], |p| {
+            p[at..at + value.len()].copy_from_slice(&value)
+        });
+        let out = d.path().join("merged.exr");
+        let o = facette(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&out)], None);
+        assert_clean_error(&o, culprit);
+        assert!(!out.exists());
+    }
+    // Sums that are finite in each part but overflow when added.
+    let d = tempfile::tempdir().unwrap();
+    let parts = two_parts(d.path());
+    for p in &parts {
+        corrupt(p, |b| b[56..64].copy_from_slice(&1.7e308f64.to_le_bytes()));
+    }
+    let out = d.path().join("merged.exr");
+    let o = facette(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&out)], None);
+    assert_clean_error(&o, "corrupt parts");
+    assert!(!out.exists());
+}
