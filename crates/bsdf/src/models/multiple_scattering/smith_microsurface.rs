@@ -378,7 +378,7 @@ impl Microsurface {
     /// orders of magnitude: the rare factor of the next-event estimate is the masking
     /// G1(o, h) = C1(h)^Λ(o), near 0 for a grazing `o` unless the walk reaches the top of the
     /// microsurface, whereas a walk entering from the grazing direction starts there. For
-    /// Beckmann α = 0.5 (`examples`-style measurement in `tests/multiple_scattering.rs` and
+    /// Beckmann α = 0.5 (`examples`-style measurement in `tests/suite/multiple_scattering.rs` and
     /// docs/materials.md) the walk from the steeper direction underestimated orders ≥ 2 by
     /// factors up to 15 at 10⁵ estimates, single estimates reaching 10⁴–10⁵ × the mean. The
     /// rule depends on the unordered pair only, so the eval estimate of f(a, b) and of
@@ -456,7 +456,7 @@ impl Microsurface {
     /// with a probability ∝ Λ(−w): for Beckmann, whose Λ decays like e^{−cot²θ/α²}, its
     /// variance is huge (unbounded as the view approaches the normal) and finite samples
     /// fall short of the mean — a non-reciprocity of several percent at tens of "standard
-    /// errors" (measured in `tests/multiple_scattering.rs`). Vertices across the interface
+    /// errors" (measured in `tests/suite/multiple_scattering.rs`). Vertices across the interface
     /// (refraction toward `o`) keep the sampled height.
     pub fn estimate(
         &self,

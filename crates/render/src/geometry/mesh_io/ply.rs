@@ -460,7 +460,7 @@ mod tests {
         assert_eq!(line, Some(17));
         // ply-rs's ASCII grammar has no NaN/inf literals: they are parse errors, with the
         // parser's own line number (non-finite binary values are tested in
-        // tests/geometry_mesh_io.rs).
+        // tests/suite/geometry_mesh_io.rs).
         for bad in ["1 nan 0 1 1", "1 one 0 1 1"] {
             let garbage = QUAD.replace("1 1 0 1 1", bad);
             let (e, line) = parse_ply(garbage.as_bytes()).unwrap_err();

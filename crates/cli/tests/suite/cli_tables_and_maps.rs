@@ -1,9 +1,7 @@
 //! End-to-end tests of `facette tabulate` in parts merged by `facette merge`, and of
 //! `facette normalmap` with `eval` reading the maps it writes.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 #[test]
 fn table_parts_merge_into_the_same_table_file() {

@@ -4,9 +4,7 @@
 //! of old files. Errors are in `scene_mitsuba_errors.rs`, rendered images in
 //! `scene_mitsuba_render.rs`.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use facette_bsdf::math::rng::Pcg32;
 use facette_bsdf::{BsdfContext, Spectrum};
 use facette_render::geometry::{Shape, Vec2, Vec3};

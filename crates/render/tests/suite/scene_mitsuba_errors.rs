@@ -2,9 +2,7 @@
 //! missing files and bad values are errors naming the file and line; parameters that only
 //! affect quality are warnings, given once.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 #[test]
 fn malformed_xml_is_an_error_with_file_and_line() {

@@ -7,7 +7,7 @@
 //! test. `FACETTE_FUZZ_CASES=20000 cargo test -p facette --profile optimized-tests --test
 //! fuzz_readers` runs a longer campaign (docs/validation.md, "Robustness").
 
-mod fuzz_support;
+use crate::fuzz_support;
 
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Masking, Ndf};

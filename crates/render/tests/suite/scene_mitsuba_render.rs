@@ -2,9 +2,7 @@
 //! values (furnace, a Lambertian plane under a point light), the example scenes without
 //! NaN, and the glint plugin.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use facette_render::geometry::{Vec2, Vec3};
 use facette_render::image::RgbImage;
 use facette_render::render::{render, RenderOptions};

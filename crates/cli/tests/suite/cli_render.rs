@@ -2,9 +2,7 @@
 //! that leave outputs untouched, time limits and interrupts, parts merged exactly, and
 //! the sampler flag.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use std::process::{Command, Stdio};
 
 const TINY_SCENE: &str = r#"

@@ -2,9 +2,7 @@
 //! error naming the culprit and a non-zero exit — no panic, no allocation abort, no
 //! infinite pixel, no clobbered output — or, for a valid extreme, a finite result.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use facette_bsdf::storage::framed::Framed;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};

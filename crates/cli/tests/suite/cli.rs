@@ -2,9 +2,7 @@
 //! `validate`, bad materials, and output into a closed pipe. Rendering is in
 //! `cli_render.rs`, tables and normal maps in `cli_tables_and_maps.rs`.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use std::io::Write;
 use std::process::{Command, Stdio};
 
