@@ -121,6 +121,12 @@ impl Camera {
         Vec3::new(sx * self.tan_x, sy * self.tan_y, 1.0)
     }
 
+    /// Whether rays read their lens sample (a thin lens); a pinhole camera ignores it.
+    #[inline]
+    pub fn has_lens(&self) -> bool {
+        self.lens_radius > 0.0
+    }
+
     /// The world origin of the rays through lens sample `u_lens`, and the world direction
     /// from it through the local pinhole direction `dl`: every ray through a lens point
     /// meets its pinhole ray on the focal plane. A pinhole camera uses its origin.

@@ -15,6 +15,13 @@
 //! BSDF's evaluation, a sampler's draws beyond its lobe and direction — come from the
 //! sample's own PCG stream.
 //!
+//! A number nothing reads is not drawn: a pinhole camera's lens pair, the light choice
+//! when one light can be chosen, the position pair when every light is a delta light, the
+//! lobe number of a model that has one lobe (the BSDF's source draws its numbers as the
+//! model asks, [`PrefixedSource`]). A dimensioned sampler's value does not depend on which
+//! other dimensions were drawn, so this saves the sampler's hashing and changes no image;
+//! the independent sampler still draws them all, in its old order.
+//!
 //! Shading uses the shading normal's frame; a direction whose side of the geometric normal
 //! disagrees with its side of the shading normal is discarded (no light leaks through
 //! interpolated normals). Texture footprints come from the camera ray's differentials at
@@ -135,15 +142,12 @@ pub fn radiance(
         let block = CAMERA_DIMENSIONS + (segment - 1) * VERTEX_DIMENSIONS;
         // Next-event estimation.
         if flags.has_smooth_part() && strategy != Strategy::BsdfOnly {
-            sampler.set_dimension(block);
-            let u = (sampler.get_1d(), sampler.get_2d());
+            let u = light_numbers(scene, sampler, block);
             l += beta * sample_light(scene, &hit, &frame, wo, &*bsdf, u, sampler, strategy);
         }
-        // Continue by BSDF sampling.
-        sampler.set_dimension(block + 3);
-        let lobe = sampler.get_1d();
-        let direction = sampler.get_2d();
-        let mut source = PrefixedSource::new(lobe, direction, sampler.rng());
+        // Continue by BSDF sampling (the lobe and direction numbers are drawn as the
+        // model asks for them).
+        let mut source = PrefixedSource::new(sampler, block + 3);
         let Some(s) = bsdf.sample(wo, &ctx, &mut source) else {
             break;
         };
@@ -170,6 +174,21 @@ pub fn radiance(
         ray = hit.spawn_ray(wi);
     }
     l
+}
+
+/// A vertex's light-selection number and light-position pair, from its block of dimensions
+/// starting at `block`; a number no light reads is left undrawn (see
+/// [`SampleStream::get_1d_where`]).
+#[inline]
+pub(crate) fn light_numbers(
+    scene: &Scene,
+    sampler: &mut SampleStream,
+    block: u32,
+) -> (f64, crate::geometry::Vec2) {
+    sampler.set_dimension(block);
+    let select = sampler.get_1d_where(scene.selector.reads_selection_number());
+    let position = sampler.get_2d_where(scene.selector.reads_position_numbers());
+    (select, position)
 }
 
 /// The shading-normal side of a world direction must match its geometric side.

@@ -102,6 +102,12 @@ impl Light {
         matches!(self, Light::Directional { .. } | Light::Environment(_))
     }
 
+    /// Whether [`sample`](Self::sample) reads its `u` (a position on an area light, a
+    /// direction of the environment); a delta light's sample is fixed.
+    pub fn reads_position_numbers(&self) -> bool {
+        !self.is_delta()
+    }
+
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
@@ -311,11 +317,17 @@ impl Light {
 pub struct LightSelector {
     cdf: Vec<f64>,
     probs: Vec<f64>,
+    /// More than one light can be chosen: the selection number matters.
+    choice: bool,
+    /// Some light reads its position pair (area and environment lights do; point, spot
+    /// and directional lights do not).
+    positions: bool,
 }
 
 impl LightSelector {
-    /// `powers[k]` is light k's power estimate, `infinite[k]` whether it is at infinity.
-    pub fn new(powers: &[f64], infinite: &[bool]) -> LightSelector {
+    /// `powers[k]` is light k's power estimate, `infinite[k]` whether it is at infinity,
+    /// `reads_position[k]` whether its samples read their position pair.
+    pub fn new(powers: &[f64], infinite: &[bool], reads_position: &[bool]) -> LightSelector {
         let n = powers.len();
         let usable = |k: usize| powers[k] > 0.0 && powers[k].is_finite();
         let at_infinity = |k: usize| infinite.get(k).copied().unwrap_or(false);
@@ -347,7 +359,27 @@ impl LightSelector {
             acc += p;
             cdf.push(acc);
         }
-        LightSelector { cdf, probs }
+        let choice = probs.iter().filter(|&&p| p > 0.0).count() > 1;
+        LightSelector {
+            cdf,
+            probs,
+            choice,
+            positions: reads_position.iter().any(|&r| r),
+        }
+    }
+
+    /// Whether [`select`](Self::select)'s result depends on its number (more than one
+    /// light can be chosen); where it does not, the integrator leaves the dimension undrawn.
+    #[inline]
+    pub fn reads_selection_number(&self) -> bool {
+        self.choice
+    }
+
+    /// Whether some light's [`Light::sample`] reads its position pair; where none does,
+    /// the integrator leaves the two dimensions undrawn.
+    #[inline]
+    pub fn reads_position_numbers(&self) -> bool {
+        self.positions
     }
 
     /// (light index, probability).

@@ -147,7 +147,7 @@ impl CameraSampling {
     ) -> (Ray, Option<RayDifferential>) {
         let off = scene.film.filter.sample(stream.get_2d());
         let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
-        let lens = stream.get_2d();
+        let lens = stream.get_2d_where(scene.camera.has_lens());
         let lens = Vec2::new(lens.x, lens.y);
         if self.footprints {
             let (ray, rd) = scene.camera.generate_ray(fx, fy, lens);

@@ -222,6 +222,13 @@ impl LaneBsdf {
         }
     }
 
+    /// Whether [`sample`](Self::sample) reads its lobe number `u_lobe` (the dielectric's
+    /// choice between reflection and refraction); the one-lobe models ignore it, and the
+    /// renderer leaves that dimension undrawn.
+    pub fn reads_lobe_number(&self) -> bool {
+        matches!(self, LaneBsdf::Dielectric { .. })
+    }
+
     /// The value f(wo, wi) (no cosine) and the density of sampling wi from wo.
     #[inline(always)]
     pub fn eval_pdf<R: Real>(&self, wo: LVec3<R>, wi: LVec3<R>) -> ([R; 3], R) {
@@ -593,6 +600,33 @@ mod tests {
                 model.describe()
             );
         }
+    }
+
+    /// A model that says it does not read its lobe number samples the same direction and
+    /// weight whatever that number is (the renderer then leaves its dimension undrawn).
+    #[test]
+    fn one_lobe_models_ignore_the_lobe_number() {
+        let mut rng = Pcg32::new(10, 2);
+        let mut checked = 0;
+        for (lane, _) in models() {
+            if lane.reads_lobe_number() {
+                continue;
+            }
+            for _ in 0..500 {
+                let wo = LVec3::<f64>::from_fn(|_| random_dir(&mut rng));
+                let (u0, u1) = (rng.next_f64(), rng.next_f64());
+                let a = lane.sample(wo, 0.0, u0, u1);
+                let b = lane.sample(wo, 0.999, u0, u1);
+                assert_eq!(a.ok, b.ok);
+                if a.ok {
+                    assert_eq!(a.wi.lane(0), b.wi.lane(0));
+                    assert_eq!(a.weight, b.weight);
+                    assert_eq!(a.pdf, b.pdf);
+                }
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 4 * 500, "Lambert and the three conductors");
     }
 
     #[test]

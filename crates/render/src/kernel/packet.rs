@@ -17,7 +17,9 @@
 //! 8-lane operation is two instructions) and for AVX2 + FMA, chosen at run time.
 
 use crate::geometry::{HitDetail, Ray, RayDifferential, SurfaceHit, Vec3};
-use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
+use crate::integrator::{
+    light_numbers, power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS,
+};
 use crate::lights::{Light, LightSample};
 use crate::materials::MaterialBsdf;
 use crate::render::{CameraSampling, PixelSums};
@@ -284,9 +286,8 @@ fn block(path: &Path) -> u32 {
 /// material is evaluated at once.
 #[inline]
 fn sample_light(scene: &Scene, path: &mut Path, v: &Vertex) -> Option<LightCandidate> {
-    path.stream.set_dimension(block(path));
-    let u_select = path.stream.get_1d();
-    let u = path.stream.get_2d();
+    let first = block(path);
+    let (u_select, u) = light_numbers(scene, &mut path.stream, first);
     let (k, p_select) = scene.selector.select(u_select)?;
     let ls = scene.lights[k].sample(&scene.geometry, v.hit.p, v.hit.ng, u)?;
     if ls.radiance.is_black() {
@@ -417,12 +418,10 @@ fn sample_materials<R: Real>(
         let (Some(path), Some(v)) = (&mut lanes[k], &vertices[k]) else {
             continue;
         };
-        path.stream.set_dimension(block(path) + 3);
-        let lobe = path.stream.get_1d();
-        let dir = path.stream.get_2d();
+        let first = block(path) + 3;
         match &v.scalar {
             Some(bsdf) => {
-                let mut source = PrefixedSource::new(lobe, dir, path.stream.rng());
+                let mut source = PrefixedSource::new(&mut path.stream, first);
                 out[k] = bsdf
                     .sample(v.wo, &ctx, &mut source)
                     .map(|s| MaterialSample {
@@ -435,6 +434,14 @@ fn sample_materials<R: Real>(
                     });
             }
             None => {
+                // The lane model says whether it reads a lobe number (one-lobe models do
+                // not: the dimension is left undrawn).
+                let reads_lobe = scene.materials[v.material as usize]
+                    .lane_bsdf()
+                    .is_some_and(|m| m.reads_lobe_number());
+                path.stream.set_dimension(first);
+                let lobe = path.stream.get_1d_where(reads_lobe);
+                let dir = path.stream.get_2d();
                 numbers[k] = [lobe, dir.x, dir.y];
                 lane_set |= 1 << k;
             }

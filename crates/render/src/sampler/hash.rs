@@ -33,13 +33,21 @@ pub(crate) fn hash_unit(h: u64) -> f64 {
 /// depends only on the more significant bits. The multipliers are Burley's.
 #[inline]
 pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
-    let mut x = v.reverse_bits();
-    x = x.wrapping_add(seed);
+    laine_karras(v.reverse_bits(), seed).reverse_bits()
+}
+
+/// The Laine–Karras style hash of [`owen_scramble`] on the bit-reversed value: each output
+/// bit depends only on the input bits below it. `owen_scramble(v.reverse_bits(), s)` is
+/// `laine_karras(v, s).reverse_bits()`, which the Sobol sampler uses to skip two
+/// reversals for its first dimension (the radical inverse is itself a reversal).
+#[inline]
+pub(crate) fn laine_karras(x: u32, seed: u32) -> u32 {
+    let mut x = x.wrapping_add(seed);
     x ^= x.wrapping_mul(0x6c50_b47c);
     x ^= x.wrapping_mul(0xb82f_1e52);
     x ^= x.wrapping_mul(0xc7af_e638);
     x ^= x.wrapping_mul(0x8d22_f6e6);
-    x.reverse_bits()
+    x
 }
 
 /// Element `i` of a pseudo-random permutation of [0, n) chosen by `key`, in O(1) memory:

@@ -182,6 +182,42 @@ impl SampleStream {
         v
     }
 
+    /// Next dimension where the caller reads it (`used`), else the dimension is skipped and
+    /// ½ returned. A dimensioned sampler (Sobol, stratified) then does no work for a
+    /// number nobody reads — a pinhole camera's lens, the light choice among one light, a
+    /// point light's position, a one-lobe material's lobe — and every other dimension keeps
+    /// its value, so images do not change. `Independent` still draws (its PCG stream is
+    /// consumed in call order, and its images stay those of before).
+    #[inline]
+    pub fn get_1d_where(&mut self, used: bool) -> f64 {
+        if used || matches!(self.pattern, Pattern::Independent) {
+            self.get_1d()
+        } else {
+            self.dimension = self.dimension.wrapping_add(1);
+            0.5
+        }
+    }
+
+    /// [`get_2d`](Self::get_2d) where `used`, else the pair is skipped and (½, ½) returned
+    /// (see [`get_1d_where`](Self::get_1d_where)).
+    #[inline]
+    pub fn get_2d_where(&mut self, used: bool) -> DVec2 {
+        if used || matches!(self.pattern, Pattern::Independent) {
+            self.get_2d()
+        } else {
+            self.dimension = self.dimension.wrapping_add(2);
+            DVec2::splat(0.5)
+        }
+    }
+
+    /// Whether every value is a function of its dimension (Sobol, stratified), so that
+    /// numbers may be drawn in any order or not at all; `false` for `Independent`, whose
+    /// values depend on how many were drawn before.
+    #[inline]
+    pub fn is_dimensioned(&self) -> bool {
+        !matches!(self.pattern, Pattern::Independent)
+    }
+
     /// Jump to dimension `d` (the integrator gives each path vertex a fixed block of
     /// dimensions). No-op for `Independent`.
     pub fn set_dimension(&mut self, d: u32) {

@@ -7,28 +7,50 @@
 //! 2D point of one scrambled (0, 2)-sequence, so that it stays stratified in 2D) and the
 //! rest to come from the sample's free PCG stream. Matching by kind of call rather than by
 //! position gives every model the right dimensions without the BSDF knowing about samplers.
+//!
+//! The two prefix values are drawn when the model first asks for them: a model that never
+//! draws a lobe number (one lobe) costs the sampler nothing for it. Their values do not
+//! depend on when they are drawn (a dimension's value is a function of the dimension),
+//! except with the `Independent` sampler, for which both are drawn at construction in the
+//! order they always were.
 
-use facette_bsdf::math::rng::{Pcg32, RandomSource};
+use super::SampleStream;
+use facette_bsdf::math::rng::RandomSource;
 use glam::DVec2;
 
-/// Its first `next_f64` call returns `lobe`, its first `next_2d` call returns `direction`;
-/// every other call draws from `rest`.
+/// One prefix value: its dimension until drawn, then its value, then taken.
+#[derive(Clone, Copy, Debug)]
+enum Prefix<T> {
+    Dimension(u32),
+    Drawn(T),
+    Taken,
+}
+
+/// Its first `next_f64` call returns the lobe dimension's value, its first `next_2d` call
+/// the direction pair's; every other call draws from the sample's free PCG stream.
 pub struct PrefixedSource<'a> {
-    lobe: Option<f64>,
-    direction: Option<DVec2>,
-    rest: &'a mut Pcg32,
+    lobe: Prefix<f64>,
+    direction: Prefix<DVec2>,
+    stream: &'a mut SampleStream,
 }
 
 impl<'a> PrefixedSource<'a> {
-    /// The values must lie in [0, 1), as every `RandomSource` value does.
-    pub fn new(lobe: f64, direction: DVec2, rest: &'a mut Pcg32) -> Self {
-        debug_assert!([lobe, direction.x, direction.y]
-            .iter()
-            .all(|v| (0.0..1.0).contains(v)));
+    /// The lobe number at dimension `lobe_dimension` of `stream`, the direction pair at the
+    /// two dimensions after it.
+    pub fn new(stream: &'a mut SampleStream, lobe_dimension: u32) -> Self {
+        let (mut lobe, mut direction) = (
+            Prefix::Dimension(lobe_dimension),
+            Prefix::Dimension(lobe_dimension + 1),
+        );
+        if !stream.is_dimensioned() {
+            stream.set_dimension(lobe_dimension);
+            lobe = Prefix::Drawn(stream.get_1d());
+            direction = Prefix::Drawn(stream.get_2d());
+        }
         PrefixedSource {
-            lobe: Some(lobe),
-            direction: Some(direction),
-            rest,
+            lobe,
+            direction,
+            stream,
         }
     }
 }
@@ -36,17 +58,25 @@ impl<'a> PrefixedSource<'a> {
 impl RandomSource for PrefixedSource<'_> {
     #[inline]
     fn next_f64(&mut self) -> f64 {
-        match self.lobe.take() {
-            Some(v) => v,
-            None => self.rest.next_f64(),
+        match std::mem::replace(&mut self.lobe, Prefix::Taken) {
+            Prefix::Dimension(d) => {
+                self.stream.set_dimension(d);
+                self.stream.get_1d()
+            }
+            Prefix::Drawn(v) => v,
+            Prefix::Taken => self.stream.rng().next_f64(),
         }
     }
 
     #[inline]
     fn next_2d(&mut self) -> DVec2 {
-        match self.direction.take() {
-            Some(v) => v,
-            None => self.rest.next_2d(),
+        match std::mem::replace(&mut self.direction, Prefix::Taken) {
+            Prefix::Dimension(d) => {
+                self.stream.set_dimension(d);
+                self.stream.get_2d()
+            }
+            Prefix::Drawn(v) => v,
+            Prefix::Taken => self.stream.rng().next_2d(),
         }
     }
 }
@@ -54,33 +84,55 @@ impl RandomSource for PrefixedSource<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampler::{PixelSampler, SamplerKind};
 
-    #[test]
-    fn sampler_prefixed_source_lobe_then_direction() {
-        let mut rng = Pcg32::new(4, 2);
-        let mut reference = rng.clone();
-        {
-            let mut src = PrefixedSource::new(0.25, DVec2::new(0.5, 0.75), &mut rng);
-            assert_eq!(src.next_f64(), 0.25);
-            assert_eq!(src.next_2d(), DVec2::new(0.5, 0.75));
-            for _ in 0..5 {
-                assert_eq!(src.next_f64(), reference.next_f64());
-            }
-            assert_eq!(src.next_2d(), reference.next_2d());
-        }
-        // The generator it borrowed has advanced by exactly the draws beyond the prefix.
-        assert_eq!(rng.next_u32(), reference.next_u32());
+    fn stream(kind: SamplerKind) -> SampleStream {
+        PixelSampler::new(kind, 7, 16, 16, 64).stream(3, 5, 11)
     }
 
+    /// The lobe number and the direction pair are the stream's dimensions d and (d+1, d+2)
+    /// whichever is asked first, drawn or not; further draws come from the PCG stream.
     #[test]
-    fn sampler_prefixed_source_direction_first() {
-        // A model that draws its direction before its lobe (the rough dielectric) still
-        // gets the pair as its direction and the single number as its lobe.
-        let mut rng = Pcg32::new(9, 1);
-        let mut reference = rng.clone();
-        let mut src = PrefixedSource::new(0.125, DVec2::new(0.375, 0.625), &mut rng);
-        assert_eq!(src.next_2d(), DVec2::new(0.375, 0.625));
-        assert_eq!(src.next_f64(), 0.125);
+    fn sampler_prefixed_source_takes_the_vertex_dimensions_in_either_order() {
+        for kind in [SamplerKind::Sobol, SamplerKind::Stratified] {
+            let mut expected = stream(kind);
+            expected.set_dimension(9);
+            let (lobe, dir) = (expected.get_1d(), expected.get_2d());
+            let mut reference = expected.rng().clone();
+
+            let mut s = stream(kind);
+            let mut src = PrefixedSource::new(&mut s, 9);
+            assert_eq!(src.next_2d(), dir, "{kind:?}");
+            assert_eq!(src.next_f64(), lobe, "{kind:?}");
+            assert_eq!(src.next_f64(), reference.next_f64());
+            assert_eq!(src.next_2d(), reference.next_2d());
+
+            // A one-lobe model draws only its direction: the lobe's dimension is not
+            // computed, and the direction is the same pair.
+            let mut s = stream(kind);
+            let mut src = PrefixedSource::new(&mut s, 9);
+            assert_eq!(src.next_2d(), dir);
+            let mut reference = s.rng().clone();
+            let mut src = PrefixedSource::new(&mut s, 9);
+            assert_eq!(src.next_f64(), lobe);
+            assert_eq!(src.next_2d(), dir);
+            assert_eq!(src.next_f64(), reference.next_f64());
+        }
+    }
+
+    /// The independent sampler draws the lobe number, then the pair, from its PCG stream at
+    /// construction, whatever the model asks first: its images stay those of before.
+    #[test]
+    fn sampler_prefixed_source_independent_draws_in_the_old_order() {
+        let mut expected = stream(SamplerKind::Independent);
+        let (lobe, dir) = (expected.get_1d(), expected.get_2d());
+        let mut reference = expected.rng().clone();
+        let mut s = stream(SamplerKind::Independent);
+        let mut src = PrefixedSource::new(&mut s, 9);
+        assert_eq!(src.next_2d(), dir);
+        assert_eq!(src.next_f64(), lobe);
         assert_eq!(src.next_f64(), reference.next_f64());
+        // The generator has advanced by exactly the draws made.
+        assert_eq!(s.rng().next_u32(), reference.next_u32());
     }
 }

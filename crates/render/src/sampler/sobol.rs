@@ -32,7 +32,7 @@
 //! sample numbers at or above the rounded-up spp (which have no place in the pixel's
 //! block) an independent tile; nothing overflows and every sample keeps its own numbers.
 
-use super::hash::owen_scramble;
+use super::hash::{laine_karras, owen_scramble};
 use facette_bsdf::math::rng::mix_seed;
 use glam::DVec2;
 
@@ -70,9 +70,17 @@ const fn pascal_mod2_columns() -> [u32; 32] {
 
 /// Sobol dimension 0 of `index` as a 32-bit fraction: the van der Corput radical inverse,
 /// the bits of the index mirrored around the binary point.
+#[cfg(test)]
 #[inline]
 fn sobol_0(index: u32) -> u32 {
     index.reverse_bits()
+}
+
+/// `owen_scramble(sobol_0(index), seed)`: the radical inverse is a bit reversal, and the
+/// scramble's first reversal undoes it.
+#[inline]
+fn scrambled_sobol_0(index: u32, seed: u32) -> u32 {
+    laine_karras(index, seed).reverse_bits()
 }
 
 /// The generator matrix of dimension 1 applied to every byte value at each of the four
@@ -259,7 +267,7 @@ impl ZSobolSample {
     /// Camera-sample dimension `dim` as one number: Sobol dimension 0, scrambled.
     pub(crate) fn get_1d(&self, dim: u32) -> f64 {
         let (index, seeds) = self.dimension(dim);
-        to_unit(owen_scramble(sobol_0(index), seeds[0]))
+        to_unit(scrambled_sobol_0(index, seeds[0]))
     }
 
     /// Camera-sample dimensions `dim` and `dim + 1` as one pair: Sobol dimensions 0 and 1 of
@@ -267,7 +275,7 @@ impl ZSobolSample {
     pub(crate) fn get_2d(&self, dim: u32) -> DVec2 {
         let (index, seeds) = self.dimension(dim);
         DVec2::new(
-            to_unit(owen_scramble(sobol_0(index), seeds[0])),
+            to_unit(scrambled_sobol_0(index, seeds[0])),
             to_unit(owen_scramble(sobol_1(index), seeds[1])),
         )
     }
@@ -316,6 +324,13 @@ mod tests {
                     .collect();
                 assert!(is_02_net(&pts, m), "m {m} block {block}");
             }
+        }
+        // The shortcut for the scrambled first dimension is the scramble itself.
+        let mut h = 0x1234_5678_9abc_def0u64;
+        for _ in 0..10_000 {
+            h = mix_seed(h, 1);
+            let (i, seed) = (h as u32, (h >> 32) as u32);
+            assert_eq!(scrambled_sobol_0(i, seed), owen_scramble(sobol_0(i), seed));
         }
     }
 

@@ -76,7 +76,8 @@ pub(super) fn create_selector(lights: &[Light], geometry: &SceneGeometry) -> Lig
     };
     let powers: Vec<f64> = lights.iter().map(|l| l.power(geometry, radius)).collect();
     let infinite: Vec<bool> = lights.iter().map(Light::is_infinite).collect();
-    LightSelector::new(&powers, &infinite)
+    let reads_position: Vec<bool> = lights.iter().map(Light::reads_position_numbers).collect();
+    LightSelector::new(&powers, &infinite, &reads_position)
 }
 
 /// One described light with where its errors point.
