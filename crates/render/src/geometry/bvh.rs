@@ -368,17 +368,15 @@ impl Bvh {
                 let node = &self.nodes[cur.index as usize];
                 let (hit, _) = rb.hits(node, limit);
                 let mut next = None;
-                for k in 0..WIDTH {
-                    if hit[k] {
-                        let e = Entry {
-                            index: node.child[k],
-                            count: node.count[k] as u32,
-                            t: 0.0,
-                        };
-                        if let Some(prev) = next.replace(e) {
-                            stack[sp].write(prev);
-                            sp += 1;
-                        }
+                for (k, _) in hit.iter().enumerate().filter(|(_, &h)| h) {
+                    let e = Entry {
+                        index: node.child[k],
+                        count: node.count[k] as u32,
+                        t: 0.0,
+                    };
+                    if let Some(prev) = next.replace(e) {
+                        stack[sp].write(prev);
+                        sp += 1;
                     }
                 }
                 if let Some(e) = next {
