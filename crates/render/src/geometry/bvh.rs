@@ -69,9 +69,13 @@
 //! of a leaf contiguous in memory.
 //!
 //! # Measured
-//! On the geometry benchmark (torus knot, `crates/render/benches/geometry.rs`) see
-//! docs/performance.md; the binary tree it replaces (f32 boxes tested one at a time in
-//! f64) is described there too.
+//! Against the binary tree it replaced (the same build, 32-byte nodes, f32 boxes tested
+//! one at a time in f64, near child first by the split axis), on the geometry benchmark
+//! (`crates/render/benches/geometry.rs`, torus knot, 2 threads, interleaved runs on a
+//! loaded 2-core machine): closest hit 1.4–1.5× faster for camera rays and 1.5–1.7× for
+//! random rays, occlusion 1.5–1.65×, at 10 k and at 1 M triangles; the build time is
+//! unchanged within noise (the collapse is a sequential pass over the binary nodes). The
+//! images rendered are bit-identical. Figures: docs/performance.md.
 
 use super::bounds::Bounds3;
 use super::ray::Ray;
