@@ -18,8 +18,10 @@
 //! without fix-ups; their boxes are rounded outwards to f32 (a box never shrinks).
 //!
 //! # Collapse to four children
-//! The binary tree is then collapsed top-down (the "BVH4 from BVH2" collapse of Embree and
-//! of Wald, Benthin and Boulos, "Getting rid of packets", 2008): a wide node starts with
+//! The binary tree is then collapsed top-down (Dammertz et al., "Shallow bounding volume
+//! hierarchies for fast SIMD ray tracing of incoherent rays", 2008; Wald, Benthin and
+//! Boulos, "Getting rid of packets", 2008; Embree's wide builders open the child of largest
+//! area the same way): a wide node starts with
 //! its binary node's two children and repeatedly replaces the interior child of largest
 //! surface area by its two children until it has four or only leaves are left. Binary
 //! leaves stay leaves (at most [`MAX_LEAF`] primitives). Unused child slots hold an empty
