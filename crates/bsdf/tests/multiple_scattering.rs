@@ -4,7 +4,7 @@
 //! today's single-scattering lobe; height-distribution independence; reciprocity; the
 //! validation suite on the new modes. Fixed seeds; every figure is printed.
 
-use facette_bsdf::math::rng::Pcg32;
+use facette_bsdf::math::rng::{mix_seed, Pcg32};
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Distribution, Ggx, Masking, Ndf};
@@ -173,23 +173,37 @@ fn dielectric_reflectance_plus_transmittance_is_one_from_both_sides() {
 /// the walk's estimator is heavy-tailed and fewer points underestimate its variance). The
 /// totals are the albedo by the sampled weights and by integrating `eval`: they must agree.
 fn eval_against_samples(toml: &str, wo: Vec3, ctx: BsdfContext, region: f64, seed: u64) {
+    eval_against_samples_with(toml, wo, ctx, region, 100_000, seed);
+}
+
+/// [`eval_against_samples`] with `samples` draws; `region` 0 tests the whole sphere.
+fn eval_against_samples_with(
+    toml: &str,
+    wo: Vec3,
+    ctx: BsdfContext,
+    region: f64,
+    samples: usize,
+    seed: u64,
+) {
     let b = material(toml);
     let o = estimator_chi2_test(
         &SphereMap::standard(),
         &EstimatorChi2Config {
             bins: (16, 32),
-            samples: 100_000,
+            samples,
             strata: 32,
             seed,
         },
-        |wi| wi.z * region > 0.0,
+        |wi| region == 0.0 || wi.z * region > 0.0,
         |r| b.sample(wo, &ctx, r).map(|s| (s.wi, s.weight.average())),
         |wi, r| b.eval(wo, wi, &ctx, r).average() * wi.z.abs(),
     );
     println!(
         "{toml} θ_o = {:.0}°, {}: {}",
         wo.z.acos().to_degrees(),
-        if region * wo.z > 0.0 {
+        if region == 0.0 {
+            "whole sphere"
+        } else if region * wo.z > 0.0 {
             "reflection"
         } else {
             "transmission"
@@ -202,7 +216,7 @@ fn eval_against_samples(toml: &str, wo: Vec3, ctx: BsdfContext, region: f64, see
 
 #[test]
 fn the_walks_eval_agrees_with_its_samples() {
-    let cases: Vec<(&str, Vec3, BsdfContext, f64)> = vec![
+    let mut cases: Vec<(&str, Vec3, BsdfContext, f64)> = vec![
         (
             r#"{type = "conductor", distribution = "ggx", alpha = 1.0, scattering = "multiple"}"#,
             spherical_direction(0.5, 0.3),
@@ -234,8 +248,49 @@ fn the_walks_eval_agrees_with_its_samples() {
             1.0,
         ),
     ];
+    // Glass at grazing incidence (85°), from both sides: before the walk's remainder was
+    // split where it leaves the side of `o` (`SPLIT_AT_CROSSING`), GGX α = 0.7 from inside
+    // failed here (docs/materials.md, "GGX glass at grazing").
+    let grazing = |side: f64| {
+        let w = spherical_direction(85f64.to_radians(), 0.4);
+        Vec3::new(w.x, w.y, side * w.z)
+    };
+    let glass =
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.7, scattering = "multiple"}"#;
+    let rough =
+        r#"{type = "dielectric", distribution = "beckmann", alpha = 1.0, scattering = "multiple"}"#;
+    cases.extend([
+        (glass, grazing(-1.0), BsdfContext::RADIANCE, -1.0),
+        (glass, grazing(-1.0), BsdfContext::RADIANCE, 1.0),
+        (glass, grazing(1.0), BsdfContext::RADIANCE, 1.0),
+        (glass, grazing(1.0), BsdfContext::RADIANCE, -1.0),
+        (rough, grazing(-1.0), BsdfContext::IMPORTANCE, -1.0),
+        (rough, grazing(1.0), BsdfContext::IMPORTANCE, -1.0),
+    ]);
     for (k, (toml, wo, ctx, region)) in cases.into_iter().enumerate() {
         eval_against_samples(toml, wo, ctx, region, 100 + k as u64);
+    }
+}
+
+#[test]
+fn glass_at_grazing_passes_validates_eval_against_samples() {
+    // Exactly `facette validate`'s test of GGX glass α = 0.7 at 85° (1e6 draws, 16 × 32
+    // cells of 32 × 32 eval estimates, its seeds: incidence k of 8, `mix_seed(7, 8k)`).
+    // Measured p before the walk's remainder was split where it leaves the side of `o`:
+    // 3.5e-5 from inside (k = 7), 2.0e-2 from outside (k = 3); after: 3.3e-2 and 0.15.
+    let glass =
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.7, scattering = "multiple"}"#;
+    for (k, side) in [(7u64, -1.0), (3, 1.0)] {
+        let w = spherical_direction(85f64.to_radians(), 0.4);
+        let wo = Vec3::new(w.x, w.y, side * w.z);
+        eval_against_samples_with(
+            glass,
+            wo,
+            BsdfContext::RADIANCE,
+            0.0,
+            1_000_000,
+            mix_seed(7, 8 * k),
+        );
     }
 }
 
