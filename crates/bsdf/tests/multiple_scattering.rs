@@ -163,10 +163,57 @@ fn dielectric_reflectance_plus_transmittance_is_one_from_both_sides() {
     );
     assert!(worst_walk < 1e-4, "{worst_walk}");
     assert!(worst_comp < 5e-3, "{worst_comp}");
-    // KC17's reflection/transmission split is a model, not the walk: measured 0.42 (GGX
-    // α = 1.5 at 85° from outside, where the compensation reflects what the walk transmits;
-    // documented in docs/materials.md), bounded.
-    assert!(worst_split < 0.45, "{worst_split}");
+    // The split is a model, not the walk: measured 0.13 at GGX α = 1.5 (it was 0.42 at 85°
+    // from outside before the split followed the caught light; docs/materials.md), bounded.
+    // Beckmann α ≤ 1 and GGX α ≤ 0.3 are held to 2 % in the test below.
+    assert!(worst_split < 0.15, "{worst_split}");
+}
+
+#[test]
+fn compensated_glass_splits_reflection_and_transmission_like_the_walk() {
+    // R and T of `energy = "compensated"` each within 2 % (absolute) of the random walk's
+    // (`scattering = "multiple"`), at 0, 45, 70 and 85° from both sides, η = 1.5: flux
+    // (importance mode). Measured figures in docs/materials.md.
+    let mut worst: (f64, String) = (0.0, String::new());
+    for (dist, alphas) in [
+        ("beckmann", &[0.1, 0.3, 0.5, 0.7, 1.0][..]),
+        ("ggx", &[0.1, 0.3][..]),
+    ] {
+        for &alpha in alphas {
+            let ms = material(&format!(
+                r#"{{type = "dielectric", distribution = "{dist}", alpha = {alpha}, ior = 1.5, scattering = "multiple"}}"#
+            ));
+            let comp = material(&format!(
+                r#"{{type = "dielectric", distribution = "{dist}", alpha = {alpha}, ior = 1.5, masking = "smith-correlated", energy = "compensated"}}"#
+            ));
+            for (k, deg) in [0.0f64, 45.0, 70.0, 85.0].iter().enumerate() {
+                for side in [1.0, -1.0] {
+                    let w = spherical_direction(deg.to_radians(), 0.4);
+                    let wo = Vec3::new(w.x, w.y, side * w.z);
+                    let ctx = BsdfContext::IMPORTANCE;
+                    let seed = 4000 + 16 * k as u64 + (side < 0.0) as u64;
+                    let walk = sampled(ms.as_ref(), wo, &ctx, 40_000, seed);
+                    let c = sampled(comp.as_ref(), wo, &ctx, 80_000, seed);
+                    let (dr, dt) = (c[0] - walk[0], c[2] - walk[2]);
+                    let label = format!(
+                        "{dist} α = {alpha} θ = {deg}° {}: walk R {:.4} T {:.4}, compensated R {:.4} T {:.4} (ΔR {dr:+.4}, ΔT {dt:+.4})",
+                        if side > 0.0 { "outside" } else { "inside " },
+                        walk[0],
+                        walk[2],
+                        c[0],
+                        c[2]
+                    );
+                    println!("{label}");
+                    let d = dr.abs().max(dt.abs());
+                    if d > worst.0 {
+                        worst = (d, label);
+                    }
+                }
+            }
+        }
+    }
+    println!("largest |ΔR| or |ΔT|: {:.4} ({})", worst.0, worst.1);
+    assert!(worst.0 < 0.02, "{}", worst.1);
 }
 
 /// Eval against the histogram of `sample` for the random walk (32 × 32 estimates per cell:

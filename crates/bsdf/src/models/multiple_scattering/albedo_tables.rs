@@ -280,6 +280,18 @@ pub fn directional_albedo(
     (sum / g1).clamp(0.0, 1.0)
 }
 
+/// The isotropic lobe of the kind of `ndf` at width `alpha` (the tables' convention for
+/// anisotropic lobes: α = √(α_u α_v)); `None` for kinds without tables.
+pub fn isotropic_lobe(ndf: &Ndf, alpha: f64) -> Option<Ndf> {
+    isotropic_like(ndf, alpha)
+}
+
+/// The distribution kind a table is built for (its cache key); an error for the kinds
+/// without tables.
+pub fn kind_of_table(ndf: &Ndf) -> ParamResult<&'static str> {
+    kind_of(ndf)
+}
+
 impl AlbedoTable {
     /// The shared table for the lobe `ndf` (its kind and G1 form; widths are the table's
     /// axis), `masking` and `fresnel`, built on first use.
