@@ -206,7 +206,6 @@ fn raw_shares(ndf: &Ndf, alpha: f64, masking: Masking, eta: f64) -> Shares {
     let s = SHARE_NODES;
     let mut kernel = vec![0.0; 4 * s * s];
     let mut leave_out = vec![0.0; 2 * s];
-    let mut caught = [[0.0; SHARE_NODES]; 2];
     let mut rows: Vec<([f64; SHARE_NODES], [f64; SHARE_NODES])> = Vec::with_capacity(2 * s);
     for side in 0..2 {
         let rel = if side == 0 { eta } else { 1.0 / eta };
@@ -219,7 +218,6 @@ fn raw_shares(ndf: &Ndf, alpha: f64, masking: Masking, eta: f64) -> Shares {
                 kernel[state * 2 * s + side * s + j] = own[j];
                 kernel[state * 2 * s + other_side * s + j] = oth[j];
             }
-            caught[side][k] = own.iter().sum::<f64>() + oth.iter().sum::<f64>();
             rows.push((own, oth));
         }
     }
@@ -278,7 +276,7 @@ fn raw_shares(ndf: &Ndf, alpha: f64, masking: Masking, eta: f64) -> Shares {
             for j in 0..s {
                 out += own[j] * x[side * s + j] + oth[j] * x[(1 - side) * s + j];
             }
-            let total = caught[side][k];
+            let total = own.iter().sum::<f64>() + oth.iter().sum::<f64>();
             let back = if side == 0 { out } else { total - out };
             shares[side][k] = if total > 1e-12 {
                 (back / total).clamp(0.0, 1.0)
