@@ -36,11 +36,15 @@
 //! only, so the shares of both sides come from the reflectances and transmittances of
 //! both. Finally the transmittances are scaled, u_A → min(1 − E_A, K_A u_A), with K_A such
 //! that ū_out and η² ū_in both become their geometric mean √(ū_out η² ū_in) (the
-//! reciprocity constraint; K by bisection). s_A is tabulated at the material's α on 33
-//! values of μ (μ_k = (k/32)², linear in between) and the averages are integrated on that
-//! interpolant (1024-point midpoint rule), so the lobes restore the energy they should; the
-//! tables are cached per distribution kind, masking, η and α (a few tens of milliseconds
-//! each). The tints multiply the lobes of their kind (`specular_reflectance` the reflection
+//! reciprocity constraint; K by bisection). s_A is tabulated on 33 values of μ
+//! (μ_k = (k/32)², linear in between) at the 40 rows of the albedo tables' α axis (built
+//! on first use, about 0.07 s of CPU a row, cached per distribution kind, masking and η, so that
+//! textured roughness rebuilds a material with lookups only) and interpolated linearly in α
+//! like E; ū at the material's α is the exact average of the product of the two
+//! interpolants (a quadratic in the row fraction, its coefficients integrated per pair of
+//! rows by a 1024-point midpoint rule), and between rows the side whose ū exceeds the
+//! reciprocity relation scales its u by the factor ≤ 1 that restores it. The lobes thus
+//! restore the energy they should and stay reciprocal at every α. The tints multiply the lobes of their kind (`specular_reflectance` the reflection
 //! lobes, `specular_transmittance` the transmission lobes). The split is a model, measured
 //! against the random walk's reflectance and transmittance in `tests/multiple_scattering.rs`
 //! and `docs/materials.md`: within 2 % absolute at 0–85° from both sides for Beckmann
@@ -52,7 +56,10 @@
 //! whose shapes are a_A, u_B ≤ 1 − E). The pdf is the exact mixture, the weight
 //! eval·|cos|/pdf.
 
-use super::albedo_tables::{isotropic_lobe, kind_of_table, table_alpha, AlbedoTable, TableFresnel};
+use super::albedo_tables::{
+    isotropic_lobe, kind_of_table, row_alpha, row_weight, table_alpha, AlbedoTable, TableFresnel,
+    ALPHA_NODES,
+};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
 use crate::finite::guard;
@@ -71,9 +78,6 @@ const SHARE_NODES: usize = 33;
 const FIRST_HIT_GRID: usize = 64;
 /// Midpoints of the rule that averages the lobes over μ.
 const AVERAGE_POINTS: usize = 1024;
-/// Share tables kept by the process-wide cache before it is emptied (textured roughness
-/// builds one per distinct α).
-const CACHE_LIMIT: usize = 4096;
 
 #[inline]
 fn share_node(k: usize) -> f64 {
@@ -103,8 +107,8 @@ struct Shares {
 #[derive(Clone, Debug)]
 struct Side {
     table: Arc<AlbedoTable>,
-    /// s_A at the nodes.
-    share: [f64; SHARE_NODES],
+    /// c_A: the factor on 1 − s that makes the averages reciprocal between table rows.
+    scale: f64,
     /// ā_A and ū_A: the averages of the compensation's reflectance and transmittance.
     reflected: f64,
     transmitted: f64,
@@ -114,10 +118,98 @@ struct Side {
 pub struct CompensatedDielectric {
     single: RoughDielectric,
     alpha: f64,
+    /// The shares at the table rows around α, and the fraction t toward the second.
+    rows: (Arc<Shares>, Arc<Shares>),
+    t: f64,
     outside: Side,
     inside: Side,
     reflect_tint: Spectrum,
     transmit_tint: Spectrum,
+}
+
+/// The shares of one (kind, masking, η) at every row of the albedo tables' α axis, and per
+/// pair of neighbouring rows the coefficients of ū(t) on each side; both built on first use.
+#[derive(Debug)]
+struct ShareRows {
+    ndf: Ndf,
+    masking: Masking,
+    eta: f64,
+    rows: Vec<OnceLock<Arc<Shares>>>,
+    pairs: Vec<OnceLock<[[f64; 3]; 2]>>,
+}
+
+impl ShareRows {
+    /// The shared rows of a lobe's kind, masking and η.
+    fn shared(ndf: &Ndf, masking: Masking, eta: f64) -> ParamResult<Arc<ShareRows>> {
+        type Key = (&'static str, &'static str, u64);
+        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<ShareRows>>>> = OnceLock::new();
+        let key = (kind_of_table(ndf)?, masking.name(), eta.to_bits());
+        let mut map = CACHE
+            .get_or_init(Default::default)
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        Ok(map
+            .entry(key)
+            .or_insert_with(|| {
+                Arc::new(ShareRows {
+                    ndf: ndf.clone(),
+                    masking,
+                    eta,
+                    rows: (0..ALPHA_NODES).map(|_| OnceLock::new()).collect(),
+                    pairs: (0..ALPHA_NODES).map(|_| OnceLock::new()).collect(),
+                })
+            })
+            .clone())
+    }
+
+    /// The shares at row j: the chain's split at α_j with ū_out = η² ū_in imposed there.
+    fn row(&self, j: usize, out_t: &AlbedoTable, in_t: &AlbedoTable) -> Arc<Shares> {
+        self.rows[j]
+            .get_or_init(|| {
+                let alpha = row_alpha(j);
+                let eta = self.eta;
+                let mut s = raw_shares(&self.ndf, alpha, self.masking, eta);
+                let cur_out = averages(out_t, alpha, &s.outside);
+                let cur_in = averages(in_t, alpha, &s.inside);
+                let target = (cur_out.1 * eta * eta * cur_in.1).sqrt();
+                retarget(out_t, alpha, &mut s.outside, target);
+                retarget(in_t, alpha, &mut s.inside, target / (eta * eta));
+                Arc::new(s)
+            })
+            .clone()
+    }
+
+    /// For rows j and j + 1, per side: q0, q1, q2 with ū(t) = (1 − t)² q0 + t (1 − t) q1 +
+    /// t² q2 — the exact average of the product of the two interpolants (shares and
+    /// 1 − E, both linear in t between the rows), by the midpoint rule in μ.
+    fn pair(&self, j: usize, out_t: &AlbedoTable, in_t: &AlbedoTable) -> [[f64; 3]; 2] {
+        *self.pairs[j].get_or_init(|| {
+            let (a, b) = (self.row(j, out_t, in_t), self.row(j + 1, out_t, in_t));
+            let (alpha_a, alpha_b) = (row_alpha(j), row_alpha(j + 1));
+            let moments =
+                |table: &AlbedoTable, sa: &[f64; SHARE_NODES], sb: &[f64; SHARE_NODES]| {
+                    let mut q = [0.0; 3];
+                    let h = 1.0 / AVERAGE_POINTS as f64;
+                    for k in 0..AVERAGE_POINTS {
+                        let mu = (k as f64 + 0.5) * h;
+                        let w = 2.0 * mu * h;
+                        let (ma, mb) = (
+                            (1.0 - table.albedo(mu, alpha_a)).max(0.0),
+                            (1.0 - table.albedo(mu, alpha_b)).max(0.0),
+                        );
+                        let (ua, ub) = (1.0 - interpolate(sa, mu), 1.0 - interpolate(sb, mu));
+                        q[0] += w * ua * ma;
+                        q[1] += w * (ua * mb + ub * ma);
+                        q[2] += w * ub * mb;
+                    }
+                    q
+                };
+            [
+                moments(out_t, &a.outside, &b.outside),
+                moments(in_t, &a.inside, &b.inside),
+            ]
+        })
+    }
 }
 
 /// Deposits `mass` at μ on the share nodes (linear weights between the two around it).
@@ -352,62 +444,45 @@ impl CompensatedDielectric {
         let out_t = AlbedoTable::shared(&lobe.ndf, lobe.masking, TableFresnel::Dielectric(eta))?;
         let in_t =
             AlbedoTable::shared(&lobe.ndf, lobe.masking, TableFresnel::Dielectric(1.0 / eta))?;
-        let shares = Self::shared_shares(&lobe.ndf, alpha, lobe.masking, eta, &out_t, &in_t)?;
+        let share_rows = ShareRows::shared(&lobe.ndf, lobe.masking, eta)?;
+        let (j, t) = row_weight(alpha);
+        let rows = (
+            share_rows.row(j, &out_t, &in_t),
+            share_rows.row(j + 1, &out_t, &in_t),
+        );
+        let [q_out, q_in] = share_rows.pair(j, &out_t, &in_t);
+        let at = |q: [f64; 3]| (1.0 - t) * (1.0 - t) * q[0] + t * (1.0 - t) * q[1] + t * t * q[2];
+        let (u_out, u_in) = (at(q_out), at(q_in));
+        // Reciprocity between the rows: the side with the larger average transmittance
+        // (against ū_out = η² ū_in) scales its u down to match.
+        let (c_out, c_in) = if u_out > eta * eta * u_in && u_out > 0.0 {
+            (eta * eta * u_in / u_out, 1.0)
+        } else if u_in > 0.0 {
+            (1.0, (u_out / (eta * eta * u_in)).min(1.0))
+        } else {
+            (1.0, 1.0)
+        };
         let (tints_r, tints_t) = single.tints();
-        let side = |table: Arc<AlbedoTable>, share: [f64; SHARE_NODES]| {
-            let (reflected, transmitted) = averages(&table, alpha, &share);
+        let side = |table: Arc<AlbedoTable>, scale: f64, u: f64| {
+            let transmitted = scale * u;
+            let reflected = ((1.0 - table.average(alpha)) - transmitted).max(0.0);
             Side {
                 table,
-                share,
+                scale,
                 reflected,
                 transmitted,
             }
         };
         Ok(CompensatedDielectric {
             alpha,
-            outside: side(out_t, shares.outside),
-            inside: side(in_t, shares.inside),
+            rows,
+            t,
+            outside: side(out_t, c_out, u_out),
+            inside: side(in_t, c_in, u_in),
             reflect_tint: tints_r,
             transmit_tint: tints_t,
             single,
         })
-    }
-
-    /// The shares for a lobe, with the reciprocity constraint ū_out = η² ū_in applied;
-    /// computed once per (kind, masking, η, α) and cached.
-    fn shared_shares(
-        ndf: &Ndf,
-        alpha: f64,
-        masking: Masking,
-        eta: f64,
-        out_t: &AlbedoTable,
-        in_t: &AlbedoTable,
-    ) -> ParamResult<Arc<Shares>> {
-        type Key = (&'static str, &'static str, u64, u64);
-        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<Shares>>>> = OnceLock::new();
-        let key = (
-            kind_of_table(ndf)?,
-            masking.name(),
-            eta.to_bits(),
-            alpha.to_bits(),
-        );
-        let cache = CACHE.get_or_init(Default::default);
-        if let Some(s) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(s.clone());
-        }
-        let mut s = raw_shares(ndf, alpha, masking, eta);
-        let cur_out = averages(out_t, alpha, &s.outside);
-        let cur_in = averages(in_t, alpha, &s.inside);
-        let target = (cur_out.1 * eta * eta * cur_in.1).sqrt();
-        retarget(out_t, alpha, &mut s.outside, target);
-        retarget(in_t, alpha, &mut s.inside, target / (eta * eta));
-        let s = Arc::new(s);
-        let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
-        if map.len() >= CACHE_LIMIT {
-            map.clear();
-        }
-        map.insert(key, s.clone());
-        Ok(s)
     }
 
     pub fn single(&self) -> &RoughDielectric {
@@ -427,7 +502,15 @@ impl CompensatedDielectric {
 
     /// s_A(μ) for light from the side of `w`: the share of its missing energy reflected.
     pub fn reflected_share(&self, w: Vec3) -> f64 {
-        interpolate(&self.side(w).share, w.z.abs())
+        let mu = w.z.abs();
+        let (a, b) = (&self.rows.0, &self.rows.1);
+        let (sa, sb) = if w.z > 0.0 {
+            (&a.outside, &b.outside)
+        } else {
+            (&a.inside, &b.inside)
+        };
+        let s = (1.0 - self.t) * interpolate(sa, mu) + self.t * interpolate(sb, mu);
+        1.0 - self.side(w).scale * (1.0 - s)
     }
 
     #[inline]
