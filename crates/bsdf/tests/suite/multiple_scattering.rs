@@ -4,7 +4,7 @@
 //! today's single-scattering lobe; height-distribution independence; reciprocity; the
 //! validation suite on the new modes. Fixed seeds; every figure is printed.
 
-use facette_bsdf::math::rng::Pcg32;
+use facette_bsdf::math::rng::{mix_seed, Pcg32};
 use facette_bsdf::math::spherical_direction;
 use facette_bsdf::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use facette_bsdf::microfacet::{Beckmann, Distribution, Ggx, Masking, Ndf};
@@ -163,33 +163,94 @@ fn dielectric_reflectance_plus_transmittance_is_one_from_both_sides() {
     );
     assert!(worst_walk < 1e-4, "{worst_walk}");
     assert!(worst_comp < 5e-3, "{worst_comp}");
-    // KC17's reflection/transmission split is a model, not the walk: measured 0.42 (GGX
-    // α = 1.5 at 85° from outside, where the compensation reflects what the walk transmits;
-    // documented in docs/materials.md), bounded.
-    assert!(worst_split < 0.45, "{worst_split}");
+    // The split is a model, not the walk: measured 0.13 at GGX α = 1.5 (it was 0.42 at 85°
+    // from outside before the split followed the caught light; docs/materials.md), bounded.
+    // Beckmann α ≤ 1 and GGX α ≤ 0.3 are held to 2 % in the test below.
+    assert!(worst_split < 0.15, "{worst_split}");
+}
+
+#[test]
+fn compensated_glass_splits_reflection_and_transmission_like_the_walk() {
+    // R and T of `energy = "compensated"` each within 2 % (absolute) of the random walk's
+    // (`scattering = "multiple"`), at 0, 45, 70 and 85° from both sides, η = 1.5: flux
+    // (importance mode). Measured figures in docs/materials.md.
+    let mut worst: (f64, String) = (0.0, String::new());
+    for (dist, alphas) in [
+        ("beckmann", &[0.1, 0.3, 0.5, 0.7, 1.0][..]),
+        ("ggx", &[0.1, 0.3][..]),
+    ] {
+        for &alpha in alphas {
+            let ms = material(&format!(
+                r#"{{type = "dielectric", distribution = "{dist}", alpha = {alpha}, ior = 1.5, scattering = "multiple"}}"#
+            ));
+            let comp = material(&format!(
+                r#"{{type = "dielectric", distribution = "{dist}", alpha = {alpha}, ior = 1.5, masking = "smith-correlated", energy = "compensated"}}"#
+            ));
+            for (k, deg) in [0.0f64, 45.0, 70.0, 85.0].iter().enumerate() {
+                for side in [1.0, -1.0] {
+                    let w = spherical_direction(deg.to_radians(), 0.4);
+                    let wo = Vec3::new(w.x, w.y, side * w.z);
+                    let ctx = BsdfContext::IMPORTANCE;
+                    let seed = 4000 + 16 * k as u64 + (side < 0.0) as u64;
+                    let walk = sampled(ms.as_ref(), wo, &ctx, 40_000, seed);
+                    let c = sampled(comp.as_ref(), wo, &ctx, 80_000, seed);
+                    let (dr, dt) = (c[0] - walk[0], c[2] - walk[2]);
+                    let label = format!(
+                        "{dist} α = {alpha} θ = {deg}° {}: walk R {:.4} T {:.4}, compensated R {:.4} T {:.4} (ΔR {dr:+.4}, ΔT {dt:+.4})",
+                        if side > 0.0 { "outside" } else { "inside " },
+                        walk[0],
+                        walk[2],
+                        c[0],
+                        c[2]
+                    );
+                    println!("{label}");
+                    let d = dr.abs().max(dt.abs());
+                    if d > worst.0 {
+                        worst = (d, label);
+                    }
+                }
+            }
+        }
+    }
+    println!("largest |ΔR| or |ΔT|: {:.4} ({})", worst.0, worst.1);
+    assert!(worst.0 < 0.02, "{}", worst.1);
 }
 
 /// Eval against the histogram of `sample` for the random walk (32 × 32 estimates per cell:
 /// the walk's estimator is heavy-tailed and fewer points underestimate its variance). The
 /// totals are the albedo by the sampled weights and by integrating `eval`: they must agree.
 fn eval_against_samples(toml: &str, wo: Vec3, ctx: BsdfContext, region: f64, seed: u64) {
+    eval_against_samples_with(toml, wo, ctx, region, 100_000, seed);
+}
+
+/// [`eval_against_samples`] with `samples` draws; `region` 0 tests the whole sphere.
+fn eval_against_samples_with(
+    toml: &str,
+    wo: Vec3,
+    ctx: BsdfContext,
+    region: f64,
+    samples: usize,
+    seed: u64,
+) {
     let b = material(toml);
     let o = estimator_chi2_test(
         &SphereMap::standard(),
         &EstimatorChi2Config {
             bins: (16, 32),
-            samples: 100_000,
+            samples,
             strata: 32,
             seed,
         },
-        |wi| wi.z * region > 0.0,
+        |wi| region == 0.0 || wi.z * region > 0.0,
         |r| b.sample(wo, &ctx, r).map(|s| (s.wi, s.weight.average())),
         |wi, r| b.eval(wo, wi, &ctx, r).average() * wi.z.abs(),
     );
     println!(
         "{toml} θ_o = {:.0}°, {}: {}",
         wo.z.acos().to_degrees(),
-        if region * wo.z > 0.0 {
+        if region == 0.0 {
+            "whole sphere"
+        } else if region * wo.z > 0.0 {
             "reflection"
         } else {
             "transmission"
@@ -202,7 +263,7 @@ fn eval_against_samples(toml: &str, wo: Vec3, ctx: BsdfContext, region: f64, see
 
 #[test]
 fn the_walks_eval_agrees_with_its_samples() {
-    let cases: Vec<(&str, Vec3, BsdfContext, f64)> = vec![
+    let mut cases: Vec<(&str, Vec3, BsdfContext, f64)> = vec![
         (
             r#"{type = "conductor", distribution = "ggx", alpha = 1.0, scattering = "multiple"}"#,
             spherical_direction(0.5, 0.3),
@@ -234,8 +295,49 @@ fn the_walks_eval_agrees_with_its_samples() {
             1.0,
         ),
     ];
+    // Glass at grazing incidence (85°), from both sides: before the walk's remainder was
+    // split where it leaves the side of `o` (`SPLIT_AT_CROSSING`), GGX α = 0.7 from inside
+    // failed here (docs/materials.md, "GGX glass at grazing").
+    let grazing = |side: f64| {
+        let w = spherical_direction(85f64.to_radians(), 0.4);
+        Vec3::new(w.x, w.y, side * w.z)
+    };
+    let glass =
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.7, scattering = "multiple"}"#;
+    let rough =
+        r#"{type = "dielectric", distribution = "beckmann", alpha = 1.0, scattering = "multiple"}"#;
+    cases.extend([
+        (glass, grazing(-1.0), BsdfContext::RADIANCE, -1.0),
+        (glass, grazing(-1.0), BsdfContext::RADIANCE, 1.0),
+        (glass, grazing(1.0), BsdfContext::RADIANCE, 1.0),
+        (glass, grazing(1.0), BsdfContext::RADIANCE, -1.0),
+        (rough, grazing(-1.0), BsdfContext::IMPORTANCE, -1.0),
+        (rough, grazing(1.0), BsdfContext::IMPORTANCE, -1.0),
+    ]);
     for (k, (toml, wo, ctx, region)) in cases.into_iter().enumerate() {
         eval_against_samples(toml, wo, ctx, region, 100 + k as u64);
+    }
+}
+
+#[test]
+fn glass_at_grazing_passes_validates_eval_against_samples() {
+    // Exactly `facette validate`'s test of GGX glass α = 0.7 at 85° (1e6 draws, 16 × 32
+    // cells of 32 × 32 eval estimates, its seeds: incidence k of 8, `mix_seed(7, 8k)`).
+    // Measured p before the walk's remainder was split where it leaves the side of `o`:
+    // 3.5e-5 from inside (k = 7), 2.0e-2 from outside (k = 3); after: 3.3e-2 and 0.15.
+    let glass =
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.7, scattering = "multiple"}"#;
+    for (k, side) in [(7u64, -1.0), (3, 1.0)] {
+        let w = spherical_direction(85f64.to_radians(), 0.4);
+        let wo = Vec3::new(w.x, w.y, side * w.z);
+        eval_against_samples_with(
+            glass,
+            wo,
+            BsdfContext::RADIANCE,
+            0.0,
+            1_000_000,
+            mix_seed(7, 8 * k),
+        );
     }
 }
 

@@ -280,6 +280,28 @@ pub fn directional_albedo(
     (sum / g1).clamp(0.0, 1.0)
 }
 
+/// The isotropic lobe of the kind of `ndf` at width `alpha` (the tables' convention for
+/// anisotropic lobes: α = √(α_u α_v)); `None` for kinds without tables.
+pub fn isotropic_lobe(ndf: &Ndf, alpha: f64) -> Option<Ndf> {
+    isotropic_like(ndf, alpha)
+}
+
+/// α of the table's row `j` (40 rows, α from 0 to 10).
+pub fn row_alpha(j: usize) -> f64 {
+    alpha_node(j.min(ALPHA_NODES - 1))
+}
+
+/// (row, fraction toward the next row) of α: E(μ, α) is (1 − t) E(μ, α_j) + t E(μ, α_{j+1}).
+pub fn row_weight(alpha: f64) -> (usize, f64) {
+    AlbedoTable::row_of(alpha)
+}
+
+/// The distribution kind a table is built for (its cache key); an error for the kinds
+/// without tables.
+pub fn kind_of_table(ndf: &Ndf) -> ParamResult<&'static str> {
+    kind_of(ndf)
+}
+
 impl AlbedoTable {
     /// The shared table for the lobe `ndf` (its kind and G1 form; widths are the table's
     /// axis), `masking` and `fresnel`, built on first use.
