@@ -47,6 +47,7 @@ pub struct FitArgs {
 pub fn run(a: FitArgs) -> Result<ExitCode> {
     if let Some(o) = &a.output {
         Format::of(o)?;
+        crate::outputs::check_writable(&[("-o", o)])?;
     }
     let options = FitOptions {
         model: a.model.clone(),

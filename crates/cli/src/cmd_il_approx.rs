@@ -36,6 +36,9 @@ enum IlApproxCommand {
 pub fn run(a: IlApproxArgs) -> Result<ExitCode> {
     match a.command {
         IlApproxCommand::Fit { samples, output } => {
+            if let Some(p) = &output {
+                crate::outputs::check_writable(&[("-o", p)])?;
+            }
             let mut fits = Vec::new();
             for fam in ApproxFamily::ALL {
                 let pb = crate::progress::bar(0, fam.name());

@@ -33,6 +33,7 @@ pub fn run(a: MeasureArgs) -> Result<ExitCode> {
             a.noise
         );
     }
+    crate::outputs::check_writable(&[("-o", &a.output)])?;
     let merl = measure_material(bsdf.as_ref(), a.noise, a.seed);
     merl.save(&a.output)?;
     println!(

@@ -49,6 +49,7 @@ pub fn run(a: NormalMapArgs) -> Result<ExitCode> {
                     "--resolution {resolution} is out of range: 1 <= resolution <= {MAX_GENERATED_SIZE}"
                 );
             }
+            crate::outputs::check_writable(&[("-o", &output)])?;
             let t0 = std::time::Instant::now();
             let map = generate(k, resolution, seed)?;
             write_normal_map(&output, &map)

@@ -361,16 +361,5 @@ pub fn check_output(path: &Path, partial: bool) -> Result<()> {
             path.display()
         ),
     }
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        bail!(
-            "-o {}: the directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    Ok(())
+    crate::outputs::check_writable(&[("-o", path)])
 }

@@ -47,6 +47,11 @@ pub fn run(a: ReproduceArgs) -> Result<ExitCode> {
     if which != "all" && !FIGURES.iter().any(|f| f.0 == which) {
         reproduce(&which, quality)?;
     }
+    let files: Vec<String> = names
+        .iter()
+        .flat_map(|n| [format!("{n}.svg"), format!("{n}.png")])
+        .collect();
+    crate::outputs::check_output_dir("-o", &a.output, &files)?;
     std::fs::create_dir_all(&a.output)
         .with_context(|| format!("cannot create {}", a.output.display()))?;
     let total = Instant::now();

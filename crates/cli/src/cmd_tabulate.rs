@@ -39,6 +39,7 @@ pub struct TabulateArgs {
 }
 
 pub fn run(a: TabulateArgs) -> Result<ExitCode> {
+    crate::outputs::check_writable(&[("-o", &a.output)])?;
     let table = parse_inline_table(&a.material).context("--material")?;
     let ty = table.get("type").and_then(|v| v.as_str()).unwrap_or("");
     if ty != "il" && ty != "interfaced-lambertian" {
@@ -178,6 +179,7 @@ pub fn merge(parts: &[std::path::PathBuf], output: &std::path::Path) -> Result<E
             output.display()
         );
     }
+    crate::outputs::check_writable(&[("-o", output)])?;
     let parts: Vec<TablePart> = parts
         .iter()
         .map(|p| TablePart::load(p))
