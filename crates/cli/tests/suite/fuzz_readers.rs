@@ -2,10 +2,12 @@
 //! fuzzer (`fuzz_support/`) over a corpus seeded from `scenes/` and the formats' own
 //! writers, one target per format — scene TOML, Mitsuba XML, OBJ, PLY, MERL, `.fctab`,
 //! `.fctpart`, `.fcpart` (payload mutated and re-framed with a valid CRC, so the header
-//! and data checks are reached, and raw framed bytes). A panic, an unclear message or a
-//! slow case fails with the seed and case number; its input is saved for a regression
-//! test. `FACETTE_FUZZ_CASES=20000 cargo test -p facette --profile optimized-tests --test
-//! fuzz_readers` runs a longer campaign (docs/validation.md, "Robustness").
+//! and data checks are reached, and raw framed bytes). A case fails with the seed and
+//! case number, its input saved for a regression test, when it panics, is slow, or is
+//! refused with an unclear message or one that does not name its culprit (the file, and
+//! for text formats the line). `FACETTE_FUZZ_CASES=20000 cargo test --profile
+//! optimized-tests --workspace --test suite fuzz_readers::` runs a longer campaign
+//! (docs/validation.md, "Robustness").
 
 use crate::fuzz_support;
 
@@ -19,7 +21,7 @@ use facette_render::geometry::mesh_io::{read_obj, read_ply};
 use facette_render::partial_film::{merge_parts, render_part, PartialFilm};
 use facette_render::render::RenderOptions;
 use facette_render::scene::{load_scene, load_scene_str};
-use fuzz_support::{cases, run};
+use fuzz_support::{cases, run, Culprit::File, Culprit::FileLine, Culprit::FileLineOrWhole};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
@@ -56,12 +58,18 @@ fn fuzz_scene_toml() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("fuzz.toml");
     let n = cases(150);
-    let r = run("scene-toml", 17, &corpus, n, 20.0, &|b| {
-        let text = std::str::from_utf8(b).map_err(|e| format!("not UTF-8: {e}"))?;
-        load_scene_str(text, &path)
-            .map(|_| ())
-            .map_err(|e| e.to_string())
-    });
+    let r = run(
+        "scene-toml",
+        17,
+        &corpus,
+        n,
+        20.0,
+        FileLine("fuzz.toml"),
+        &|b| {
+            std::fs::write(&path, b).unwrap();
+            load_scene(&path).map(|_| ()).map_err(|e| e.to_string())
+        },
+    );
     report("scene-toml", n, r);
 }
 
@@ -91,10 +99,18 @@ fn fuzz_mitsuba_xml() {
     }
     let path = dir.path().join("fuzz.xml");
     let n = cases(250);
-    let r = run("mitsuba-xml", 18, &corpus, n, 20.0, &|b| {
-        std::fs::write(&path, b).unwrap();
-        load_scene(&path).map(|_| ()).map_err(|e| e.to_string())
-    });
+    let r = run(
+        "mitsuba-xml",
+        18,
+        &corpus,
+        n,
+        20.0,
+        FileLine("fuzz.xml"),
+        &|b| {
+            std::fs::write(&path, b).unwrap();
+            load_scene(&path).map(|_| ()).map_err(|e| e.to_string())
+        },
+    );
     report("mitsuba-xml", n, r);
 }
 
@@ -130,16 +146,24 @@ fn fuzz_meshes() {
         b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n".to_vec(),
     ];
     let n = cases(300);
-    let r = run("obj", 19, &corpus, n, 10.0, &|b| {
-        std::fs::write(&obj, b).unwrap();
-        read_obj(&obj, false).map(|_| ()).map_err(|e| e.to_string())
-    });
+    let r = run(
+        "obj",
+        19,
+        &corpus,
+        n,
+        10.0,
+        FileLineOrWhole("fuzz.obj", &["mesh has no triangles"]),
+        &|b| {
+            std::fs::write(&obj, b).unwrap();
+            read_obj(&obj, false).map(|_| ()).map_err(|e| e.to_string())
+        },
+    );
     report("obj", n, r);
 
     let ply = dir.path().join("fuzz.ply");
     let corpus = vec![PLY_ASCII.as_bytes().to_vec(), ply_binary()];
     let n = cases(300);
-    let r = run("ply", 20, &corpus, n, 10.0, &|b| {
+    let r = run("ply", 20, &corpus, n, 10.0, File("fuzz.ply"), &|b| {
         std::fs::write(&ply, b).unwrap();
         read_ply(&ply).map(|_| ()).map_err(|e| e.to_string())
     });
@@ -161,7 +185,7 @@ fn fuzz_merl() {
     let head = valid[..4096].to_vec();
     let corpus = vec![head];
     let n = cases(200);
-    let r = run("merl", 21, &corpus, n, 10.0, &|b| {
+    let r = run("merl", 21, &corpus, n, 10.0, File("fuzz.binary"), &|b| {
         // The mutated head, then the rest of a valid file (so that sizes still match
         // unless the mutation changed the head's length).
         let mut file = b.to_vec();
@@ -251,39 +275,56 @@ fn fuzz_tables_and_parts() {
         .collect();
 
     let n = cases(300);
-    let r = run("fctab", 22, &[payload(&TABLE, &table)], n, 10.0, &|b| {
-        let t = BodyTable::from_bytes(&TABLE.frame(b), "fuzz.fctab").map_err(|e| e.to_string())?;
-        // An accepted table answers lookups with finite values.
-        let v = t.lookup(
-            facette_bsdf::Vec3::new(0.3, 0.1, 0.9).normalize(),
-            facette_bsdf::Vec3::new(-0.2, 0.4, 0.8).normalize(),
-        );
-        assert!(v.is_finite(), "lookup {v}");
-        Ok(())
-    });
+    let r = run(
+        "fctab",
+        22,
+        &[payload(&TABLE, &table)],
+        n,
+        10.0,
+        File("fuzz.fctab"),
+        &|b| {
+            let t =
+                BodyTable::from_bytes(&TABLE.frame(b), "fuzz.fctab").map_err(|e| e.to_string())?;
+            // An accepted table answers lookups with finite values.
+            let v = t.lookup(
+                facette_bsdf::Vec3::new(0.3, 0.1, 0.9).normalize(),
+                facette_bsdf::Vec3::new(-0.2, 0.4, 0.8).normalize(),
+            );
+            assert!(v.is_finite(), "lookup {v}");
+            Ok(())
+        },
+    );
     report("fctab", n, r);
 
     let corpus: Vec<Vec<u8>> = tparts.iter().map(|b| payload(&TABLE_PART, b)).collect();
     let n = cases(300);
-    let r = run("fctpart", 23, &corpus, n, 10.0, &|b| {
-        let p = TablePart::from_bytes(&TABLE_PART.frame(b), "fuzz.fctpart")
-            .map_err(|e| e.to_string())?;
-        // Merged with the genuine other part, the result is a table its loader accepts.
-        let other = tparts_ok.iter().find(|q| q.part != p.part).cloned();
-        if let Some(o) = other {
-            if let Ok(t) = merge_table_parts(&[p, o]) {
-                BodyTable::from_bytes(&t.to_bytes(), "merged.fctab")
-                    .map_err(|e| format!("merge wrote what its loader refuses: {e}"))
-                    .unwrap();
+    let r = run(
+        "fctpart",
+        23,
+        &corpus,
+        n,
+        10.0,
+        File("fuzz.fctpart"),
+        &|b| {
+            let p = TablePart::from_bytes(&TABLE_PART.frame(b), "fuzz.fctpart")
+                .map_err(|e| e.to_string())?;
+            // Merged with the genuine other part, the result is a table its loader accepts.
+            let other = tparts_ok.iter().find(|q| q.part != p.part).cloned();
+            if let Some(o) = other {
+                if let Ok(t) = merge_table_parts(&[p, o]) {
+                    BodyTable::from_bytes(&t.to_bytes(), "merged.fctab")
+                        .map_err(|e| format!("merge wrote what its loader refuses: {e}"))
+                        .unwrap();
+                }
             }
-        }
-        Ok(())
-    });
+            Ok(())
+        },
+    );
     report("fctpart", n, r);
 
     let corpus: Vec<Vec<u8>> = rparts.iter().map(|b| payload(&RENDER_PART, b)).collect();
     let n = cases(300);
-    let r = run("fcpart", 24, &corpus, n, 10.0, &|b| {
+    let r = run("fcpart", 24, &corpus, n, 10.0, File("fuzz.fcpart"), &|b| {
         let p = PartialFilm::from_bytes(&RENDER_PART.frame(b), Path::new("fuzz.fcpart"))
             .map_err(|e| e.to_string())?;
         // Merged with the genuine other part: an error, or an image of finite pixels.
@@ -301,7 +342,7 @@ fn fuzz_tables_and_parts() {
     // Raw framed bytes: the container's own checks (magic, version, length, CRC).
     let corpus = vec![table.clone(), tparts[0].clone(), rparts[0].clone()];
     let n = cases(300);
-    let r = run("framed", 25, &corpus, n, 10.0, &|b| {
+    let r = run("framed", 25, &corpus, n, 10.0, File("f.fc"), &|b| {
         let t = BodyTable::from_bytes(b, "f.fctab").map(|_| ());
         let p = TablePart::from_bytes(b, "f.fctpart").map(|_| ());
         let f = PartialFilm::from_bytes(b, Path::new("f.fcpart")).map(|_| ());

@@ -99,20 +99,6 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<Scene, Scen
             ),
         });
     }
-    // The size is checked before the file is read into memory.
-    if let Ok(m) = std::fs::metadata(path) {
-        facette_bsdf::limits::SCENE_FILE_BYTES
-            .check(m.len())
-            .map_err(|e| SceneError {
-                file: path.to_path_buf(),
-                line: None,
-                message: e.to_string(),
-            })?;
-    }
-    let source = std::fs::read_to_string(path).map_err(|e| SceneError {
-        file: path.to_path_buf(),
-        line: None,
-        message: format!("cannot read the scene file: {e}"),
-    })?;
+    let source = source::read_scene_text(path)?;
     load_scene_str(&source, path)
 }

@@ -124,16 +124,48 @@ pub fn cases(default: usize) -> usize {
         .unwrap_or(default)
 }
 
+/// What a refusal message must name: the file, and for text formats the line too.
+#[derive(Clone, Copy)]
+pub enum Culprit<'a> {
+    /// The file's name.
+    File(&'a str),
+    /// `name:LINE`, the file and the line of the error (text formats, where every error
+    /// has a place).
+    FileLine(&'a str),
+    /// `name:LINE`, except for the listed errors about the whole file (an OBJ file with no
+    /// triangle has no line to blame).
+    FileLineOrWhole(&'a str, &'a [&'a str]),
+}
+
+impl Culprit<'_> {
+    fn named_by(&self, message: &str) -> bool {
+        match *self {
+            Culprit::File(f) => message.contains(f),
+            Culprit::FileLine(f) => message.match_indices(f).any(|(i, _)| {
+                let rest = &message[i + f.len()..];
+                rest.strip_prefix(':')
+                    .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
+            }),
+            Culprit::FileLineOrWhole(f, whole) => {
+                Culprit::FileLine(f).named_by(message)
+                    || (message.contains(f) && whole.iter().any(|w| message.ends_with(w)))
+            }
+        }
+    }
+}
+
 /// Runs `cases` mutated inputs through `target`, which returns `Err(message)` for a
 /// refused input. A panic fails the test with the seed and case number that replay it
 /// (the input is saved under the system temp directory); so does an error with an empty
-/// message or a Rust Debug dump in it, or a case slower than `max_seconds`.
+/// message or a Rust Debug dump in it, one that does not name its `culprit`, or a case
+/// slower than `max_seconds`.
 pub fn run(
     name: &str,
     seed: u64,
     corpus: &[Vec<u8>],
     cases: usize,
     max_seconds: f64,
+    culprit: Culprit,
     target: &dyn Fn(&[u8]) -> Result<(), String>,
 ) -> (usize, usize) {
     assert!(!corpus.is_empty(), "{name}: empty corpus");
@@ -168,6 +200,17 @@ pub fn run(
                 if e.trim().is_empty() || dump.iter().any(|d| e.contains(d)) {
                     panic!(
                         "{name}: case {case} gave an unclear message `{e}`; input saved to {}",
+                        keep().display()
+                    );
+                }
+                if !culprit.named_by(&e) {
+                    if std::env::var_os("FACETTE_FUZZ_SURVEY").is_some() {
+                        println!("{name}: case {case} does not name its culprit: {e}");
+                        continue;
+                    }
+                    panic!(
+                        "{name}: case {case}: the message does not name its culprit (the file{}): `{e}`; input saved to {}",
+                        if matches!(culprit, Culprit::File(_)) { "" } else { " and line" },
                         keep().display()
                     );
                 }

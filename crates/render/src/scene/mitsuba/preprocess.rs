@@ -334,10 +334,10 @@ impl State {
 
     /// The elements an `<include>` stands for.
     fn include(&mut self, e: &Element, depth: usize) -> Result<Vec<Element>, SceneError> {
-        if depth + 1 > limits::XML_INCLUDE_DEPTH.max as usize {
+        if depth + 1 > limits::XML_INCLUDE_DEPTH.max() as usize {
             return Err(e.pos.err(format!(
                 "<include> nested deeper than {} files",
-                limits::XML_INCLUDE_DEPTH.max
+                limits::XML_INCLUDE_DEPTH.max()
             )));
         }
         self.includes += 1;

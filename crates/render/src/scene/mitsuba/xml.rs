@@ -93,19 +93,7 @@ impl Element {
 /// Reads and parses an XML file; returns its root element and its text (for hashing).
 /// A missing file or malformed XML is an error naming the file (and the line).
 pub(crate) fn read_xml_file(path: &Path) -> Result<(Element, String), SceneError> {
-    let err = |message: String| SceneError {
-        file: path.to_path_buf(),
-        line: None,
-        message,
-    };
-    // The size is checked before the file is read into memory.
-    if let Ok(m) = std::fs::metadata(path) {
-        limits::SCENE_FILE_BYTES
-            .check(m.len())
-            .map_err(|e| err(e.to_string()))?;
-    }
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| err(format!("cannot read the scene file: {e}")))?;
+    let text = crate::scene::source::read_scene_text(path)?;
     let root = parse_xml(&text, path)?;
     Ok((root, text))
 }
