@@ -17,11 +17,11 @@ pub fn count<const MIN: u64, const MAX: u64>(s: &str) -> Result<usize, String> {
 }
 
 /// Monte Carlo samples (`--samples` of albedo, eval, validate, plot).
-pub const SAMPLES: u64 = limits::SAMPLES.max;
+pub const SAMPLES: u64 = limits::SAMPLES_MAX;
 /// Microfacets of a quadrature (`--samples` of tabulate and il-approx, `--il-samples`).
 pub const QUADRATURE: u64 = 1 << 24;
 /// Points of a plotted curve.
-pub const POINTS: u64 = limits::PLOT_POINTS.max;
+pub const POINTS: u64 = limits::PLOT_POINTS_MAX;
 
 #[cfg(test)]
 mod tests {

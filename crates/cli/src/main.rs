@@ -32,7 +32,36 @@ use std::process::ExitCode;
 )]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    /// Raise a resource limit for this run, KEY=N (repeatable; also FACETTE_LIMITS=KEY=N,…).
+    /// `--limit list` prints every limit, its default and how far it can be raised.
+    #[arg(long = "limit", global = true, value_name = "KEY=N")]
+    limits: Vec<String>,
+}
+
+/// Applies `FACETTE_LIMITS`, then each `--limit` (so the flag wins); `list` prints them.
+/// Returns the exit code to stop with, if any.
+fn apply_limits(assignments: &[String]) -> Option<ExitCode> {
+    use facette_bsdf::limits;
+    if assignments.iter().any(|a| a == "list") {
+        println!("key,default,ceiling,what");
+        for l in limits::all() {
+            println!("{},{},{},{}", l.key, l.default, l.ceiling, l.what);
+        }
+        return Some(ExitCode::SUCCESS);
+    }
+    let applied = limits::set_limits_from_env().and_then(|()| {
+        assignments
+            .iter()
+            .try_for_each(|a| limits::set_limit(a).map_err(|e| format!("--limit: {e}")))
+    });
+    match applied {
+        Ok(()) => None,
+        Err(e) => {
+            eprintln!("error: {e}");
+            Some(ExitCode::from(2))
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -85,7 +114,15 @@ fn exit_quietly_on_broken_pipe() {
 fn main() -> ExitCode {
     exit_quietly_on_broken_pipe();
     let cli = Cli::parse();
-    let result = match cli.command {
+    if let Some(code) = apply_limits(&cli.limits) {
+        return code;
+    }
+    let Some(command) = cli.command else {
+        use clap::CommandFactory;
+        let _ = Cli::command().print_help();
+        return ExitCode::from(2);
+    };
+    let result = match command {
         Command::Render(a) => cmd_render::run(a),
         Command::Merge(a) => cmd_merge::run(a),
         Command::Eval(a) => cmd_eval::run(a),

@@ -94,12 +94,15 @@ impl<'a> Params<'a> {
     pub fn count(&self, key: &str) -> ParamResult<Option<usize>> {
         let v = self.usize(key)?;
         if let Some(n) = v {
-            let max = crate::limits::RECIPE_COUNT.max;
+            let max = crate::limits::RECIPE_COUNT.max();
             if n as u64 > max {
                 return Err(ParamError::OutOfRange {
                     name: key.into(),
                     value: n as f64,
-                    expected: format!("{key} <= {max} ({})", crate::limits::RECIPE_COUNT.lift),
+                    expected: format!(
+                        "{key} <= {max} ({})",
+                        crate::limits::RECIPE_COUNT.how_to_lift()
+                    ),
                 });
             }
         }

@@ -321,3 +321,208 @@ fn merge_refuses_corrupt_part_headers_without_overflow_or_huge_allocations() {
     assert_clean_error(&o, "corrupt parts");
     assert!(!out.exists());
 }
+
+#[test]
+fn every_command_checks_its_outputs_before_working() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = scene_file(d.path(), SCENE);
+    let missing = d.path().join("no/dir");
+    let out = |name: &str| missing.join(name).to_str().unwrap().to_string();
+    let a_file = d.path().join("a-file");
+    std::fs::write(&a_file, "keep").unwrap();
+    let il = "{type = \"il\", ni = 1.5, distribution = \"beckmann\", alpha = 0.3}";
+    let cases: Vec<Vec<String>> = vec![
+        vec!["render".into(), s(&scene).into(), "-o".into(), out("x.exr")],
+        vec![
+            "render".into(),
+            s(&scene).into(),
+            "--part".into(),
+            "0/2".into(),
+            "-o".into(),
+            out("x.fcpart"),
+        ],
+        vec![
+            "measure".into(),
+            "--material".into(),
+            "{type = \"lambert\"}".into(),
+            "-o".into(),
+            out("m.binary"),
+        ],
+        vec![
+            "normalmap".into(),
+            "generate".into(),
+            "scratched".into(),
+            "--resolution".into(),
+            "64".into(),
+            "-o".into(),
+            out("n.exr"),
+        ],
+        vec![
+            "tabulate".into(),
+            "--material".into(),
+            il.into(),
+            "-o".into(),
+            out("t.fctab"),
+        ],
+        vec!["il-approx".into(), "fit".into(), "-o".into(), out("c.rs")],
+        vec![
+            "fit".into(),
+            s(&a_file).into(),
+            "--model".into(),
+            "plastic".into(),
+            "-o".into(),
+            out("f.svg"),
+        ],
+        vec!["merge".into(), s(&a_file).into(), "-o".into(), out("m.exr")],
+        vec![
+            "reproduce".into(),
+            "il18-fig7".into(),
+            "--quick".into(),
+            "-o".into(),
+            s(&a_file).into(),
+        ],
+    ];
+    for args in cases {
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        let start = std::time::Instant::now();
+        let o = facette(&argv, None);
+        let secs = start.elapsed().as_secs_f64();
+        assert_clean_error(&o, "-o");
+        // Refused before the work: well under the time any of these commands needs.
+        assert!(secs < 5.0, "{argv:?} took {secs:.1} s before refusing");
+    }
+    assert!(!missing.exists());
+    assert_eq!(std::fs::read_to_string(&a_file).unwrap(), "keep");
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        2,
+        "only the scene and a-file"
+    );
+}
+
+#[test]
+fn limits_are_raised_or_lowered_by_flag_and_variable() {
+    let d = tempfile::tempdir().unwrap();
+    let o = facette(&["--limit", "list"], None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("mesh-elements,268435456,4294967295,"),
+        "{}",
+        stdout(&o)
+    );
+
+    // A mesh over a lowered element limit is refused at the line that crossed it.
+    let obj = d.path().join("quad.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let scene = scene_file(
+        d.path(),
+        &SCENE.replace(
+            "shape = \"sphere\"\nradius = 1",
+            "shape = \"obj\"\nfile = \"quad.obj\"",
+        ),
+    );
+    let out = d.path().join("x.exr");
+    let o = facette(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--limit",
+            "mesh-elements=3",
+            "--quiet",
+        ],
+        None,
+    );
+    assert_clean_error(&o, "quad.obj:4");
+    assert!(
+        stderr(&o).contains("vertex positions (`v` lines) = 4 exceeds the limit of 3"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(
+        stderr(&o).contains("--limit mesh-elements=N"),
+        "{}",
+        stderr(&o)
+    );
+    let o = facette(&["render", s(&scene), "-o", s(&out), "--quiet"], None);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // The 8×6 film is refused under a lowered pixel limit, and renders when the flag
+    // raises it again.
+    let big = scene_file(d.path(), SCENE);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_facette"));
+    cmd.args(["render", s(&big), "-o", s(&out), "--quiet"])
+        .env("FACETTE_LIMITS", "film-pixels=40")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let o = cmd.output().unwrap();
+    assert_clean_error(&o, "film pixels");
+    assert!(
+        stderr(&o).contains("--limit film-pixels=N"),
+        "{}",
+        stderr(&o)
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args([
+            "render",
+            s(&big),
+            "-o",
+            s(&out),
+            "--quiet",
+            "--limit",
+            "film-pixels=48",
+        ])
+        .env("FACETTE_LIMITS", "film-pixels=40")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "the flag wins over the variable: {}",
+        stderr(&o)
+    );
+
+    // Fixed limits, unknown keys and bad values are usage errors naming the culprit.
+    for (arg, culprit) in [
+        ("xml-depth=1000", "is fixed at 64"),
+        ("mesh-element=3", "unknown limit `mesh-element`"),
+        ("film-pixels=0", "outside 1…"),
+        ("film-pixels", "expected KEY=N"),
+    ] {
+        let o = facette(&["--limit", arg, "render", s(&scene)], None);
+        assert_clean_error(&o, culprit);
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_facette"))
+        .args(["render", s(&scene), "-o", s(&out)])
+        .env("FACETTE_LIMITS", "bogus=1")
+        .output()
+        .unwrap();
+    assert_clean_error(&o, "FACETTE_LIMITS: unknown limit `bogus`");
+}
+
+#[test]
+fn sky_colours_and_environment_maps_are_held_to_the_radiance_bound() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("x.exr");
+    let sky = SCENE.replace(
+        "type = \"constant\"\nradiance = 1.0",
+        "type = \"environment\"\nsky = { zenith = 1e20, width = 16, height = 8 }",
+    );
+    let o = facette(
+        &["render", s(&scene_file(d.path(), &sky)), "-o", s(&out)],
+        None,
+    );
+    assert_clean_error(&o, "zenith");
+    assert!(stderr(&o).contains("1e15"), "{}", stderr(&o));
+
+    let bright = SCENE.replace(
+        "type = \"constant\"\nradiance = 1.0",
+        "type = \"environment\"\nsky = { zenith = 1e10, width = 16, height = 8 }\nscale = 1e10",
+    );
+    let o = facette(
+        &["render", s(&scene_file(d.path(), &bright)), "-o", s(&out)],
+        None,
+    );
+    assert_clean_error(&o, "scale");
+    assert!(!out.exists());
+}

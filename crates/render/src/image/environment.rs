@@ -257,6 +257,23 @@ impl EnvironmentMap {
                 }
             }
         }
+        // The radiance bound of every light (`limits::MAX_RADIANCE`) holds for the map's
+        // brightest value as it is rendered, so that no film sum can overflow.
+        let brightest = image
+            .data()
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, &c| m.max(c as f64));
+        if brightest * scale > facette_bsdf::limits::MAX_RADIANCE {
+            return Err(ParamError::OutOfRange {
+                name: "scale".into(),
+                value: scale,
+                expected: format!(
+                    "the brightest pixel ({brightest:e}) × scale at most {:e} (larger values overflow the film's sums; scale the exposure instead)",
+                    facette_bsdf::limits::MAX_RADIANCE
+                ),
+            });
+        }
         let (w, h) = (image.width(), image.height());
 
         // Patch weights: Δu Δv ∫₀¹ ((1 − t) top + t bottom) sin(π (v₀ + t Δv)) dt, top and

@@ -24,6 +24,7 @@ use exr::prelude::{
 
 use super::error::ImageError;
 use super::rgb_image::RgbImage;
+use facette_bsdf::limits;
 use facette_bsdf::storage::atomic_file::{write_atomically_with, Existing};
 
 const FORMAT: &str = "OpenEXR";
@@ -179,11 +180,6 @@ fn read_layers(path: &Path) -> Result<Image<Layers<AnyChannels<FlatSamples>>>, I
     }
 }
 
-/// Largest layer read, in pixels (2²⁸: 16k × 16k).
-pub(crate) const MAX_PIXELS: usize = 1 << 28;
-/// Largest number of samples (pixels × channels, all layers) read: 4 GiB as f32.
-const MAX_SAMPLES: usize = 1 << 30;
-
 /// Reads the headers alone and rejects sizes no genuine file of this length can have,
 /// before the decoder allocates the pixel buffers: `exr` sizes them from the header, so a
 /// damaged data window would otherwise ask for hundreds of gigabytes and abort the process.
@@ -207,31 +203,22 @@ fn check_header_plausible(path: &Path) -> Result<(), ImageError> {
         })?
         .len();
     let mut chunks: u64 = 0;
-    let mut samples: usize = 0;
+    let mut samples: u64 = 0;
     for header in meta.headers.iter() {
         let (w, h) = (header.layer_size.width(), header.layer_size.height());
-        if w.checked_mul(h).is_none_or(|n| n > MAX_PIXELS) {
-            return Err(ImageError::Unsupported {
-                path: path.to_path_buf(),
-                format: FORMAT,
-                reason: format!(
-                    "a {w}×{h} layer exceeds the limit of {MAX_PIXELS} pixels (or the header \
-                     is damaged)"
-                ),
-            });
-        }
-        chunks = chunks.saturating_add(header.chunk_count as u64);
-        samples = samples.saturating_add((w * h).saturating_mul(header.channels.list.len()));
-    }
-    if samples > MAX_SAMPLES {
-        return Err(ImageError::Unsupported {
+        let unsupported = |e: facette_bsdf::limits::LimitError| ImageError::Unsupported {
             path: path.to_path_buf(),
             format: FORMAT,
-            reason: format!(
-                "{samples} samples in all exceed the limit of {MAX_SAMPLES} (or the header \
-                 is damaged)"
-            ),
-        });
+            reason: format!("{e} (or the header is damaged)"),
+        };
+        limits::IMAGE_PIXELS
+            .check_product(&[w as u64, h as u64])
+            .map_err(unsupported)?;
+        chunks = chunks.saturating_add(header.chunk_count as u64);
+        samples = samples.saturating_add(
+            (w as u64 * h as u64).saturating_mul(header.channels.list.len() as u64),
+        );
+        limits::IMAGE_SAMPLES.check(samples).map_err(unsupported)?;
     }
     // Every chunk has an 8-byte entry in the offset table and at least 8 bytes of its own.
     if chunks.saturating_mul(16) > file_len {

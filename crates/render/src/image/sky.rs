@@ -34,8 +34,9 @@ use rayon::prelude::*;
 
 use super::environment::{direction_to_uv, uv_to_direction};
 use super::error::ImageError;
-use super::exr_file::{write_exr_rgb, MAX_PIXELS};
+use super::exr_file::write_exr_rgb;
 use super::rgb_image::{from_spectrum, RgbImage};
+use facette_bsdf::limits;
 use facette_bsdf::storage::atomic_file::Existing;
 
 /// Parameters of the procedural sky (see the module table).
@@ -70,13 +71,20 @@ impl Default for SkyParams {
     }
 }
 
+/// A sky colour is a radiance: finite, ≥ 0 and within the radiance bound of every light
+/// (`limits::MAX_RADIANCE`), so that film sums cannot overflow.
 fn check_colour(name: &str, s: Spectrum) -> ParamResult<()> {
-    if !s.is_finite() || s.has_negative() {
-        return Err(ParamError::OutOfRange {
-            name: name.into(),
-            value: s.min_component(),
-            expected: "finite values ≥ 0".into(),
-        });
+    for c in 0..3 {
+        if limits::check_radiance(s[c]).is_err() {
+            return Err(ParamError::OutOfRange {
+                name: name.into(),
+                value: s[c],
+                expected: format!(
+                    "a radiance in 0…{:e} (larger values overflow the film's sums; scale the exposure instead)",
+                    limits::MAX_RADIANCE
+                ),
+            });
+        }
     }
     Ok(())
 }
@@ -94,18 +102,15 @@ fn check_range(name: &str, v: f64, lo: f64, hi: f64, expected: &str) -> ParamRes
 
 impl SkyParams {
     pub fn validate(&self) -> ParamResult<()> {
-        if self.width == 0
-            || self.height == 0
-            || self
-                .width
-                .checked_mul(self.height)
-                .is_none_or(|n| n > MAX_PIXELS)
-        {
+        if self.width == 0 || self.height == 0 {
             return Err(ParamError::Invalid(format!(
-                "sky resolution {}×{} must be at least 1×1 and at most {MAX_PIXELS} pixels",
+                "sky resolution {}×{} must be at least 1×1",
                 self.width, self.height
             )));
         }
+        limits::IMAGE_PIXELS
+            .check_product(&[self.width as u64, self.height as u64])
+            .map_err(|e| ParamError::Invalid(format!("sky resolution: {e}")))?;
         check_colour("zenith", self.zenith)?;
         check_colour("horizon", self.horizon)?;
         check_colour("ground", self.ground)?;

@@ -10,11 +10,22 @@
 use crate::geometry::error::{GeometryError, GeometryResult};
 use crate::geometry::mesh_data::MeshData;
 use crate::geometry::{Vec2, Vec3};
+use facette_bsdf::limits;
 use std::io::{BufRead, Read};
 use std::path::Path;
 
 /// Reads an OBJ file. `flip_tex_coords` maps `v ↦ 1 − v` (Mitsuba's default).
 pub fn read_obj(path: &Path, flip_tex_coords: bool) -> GeometryResult<MeshData> {
+    // The size is checked before the file is read into memory.
+    if let Ok(m) = std::fs::metadata(path) {
+        limits::MESH_FILE_BYTES.check(m.len()).map_err(|e| {
+            GeometryError::Malformed {
+                format: "OBJ",
+                message: e.to_string(),
+            }
+            .in_file(path, None)
+        })?;
+    }
     let bytes = std::fs::read(path).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
@@ -33,6 +44,7 @@ fn parse_obj(
         ignore_points: true,
         ignore_lines: true,
     };
+    check_element_counts(bytes)?;
     if let Some((line, what)) = face_index_without_data(bytes) {
         return Err((
             GeometryError::Malformed {
@@ -197,6 +209,61 @@ fn face_index_without_data(bytes: &[u8]) -> Option<(usize, &'static str)> {
         }
     }
     None
+}
+
+/// Counts the vertex lines of each kind and the face corners and triangles before `tobj`
+/// allocates for them, and holds each to [`limits::MESH_ELEMENTS`]: the file-size bound
+/// alone would let a 4 GiB file of `f` lines with thousands of corners ask for far more
+/// triangles than 32-bit indices can name. The error is at the line that crossed the
+/// limit.
+fn check_element_counts(bytes: &[u8]) -> Result<(), (GeometryError, Option<usize>)> {
+    let (mut positions, mut uvs, mut normals, mut corners, mut triangles) =
+        (0u64, 0u64, 0u64, 0u64, 0u64);
+    for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let mut words = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|w| !w.is_empty());
+        let (count, what) = match words.next() {
+            Some(b"v") => (&mut positions, "vertex positions (`v` lines)"),
+            Some(b"vt") => (&mut uvs, "texture coordinates (`vt` lines)"),
+            Some(b"vn") => (&mut normals, "normals (`vn` lines)"),
+            Some(b"f") => {
+                let n = words.count() as u64;
+                corners += n;
+                triangles += n.saturating_sub(2);
+                let over = limits::MESH_ELEMENTS
+                    .check(corners)
+                    .and_then(|_| limits::MESH_ELEMENTS.check(triangles))
+                    .map_err(|e| {
+                        e.to_string()
+                            .replace(limits::MESH_ELEMENTS.what, "face corners or triangles")
+                    });
+                if let Err(message) = over {
+                    return Err((
+                        GeometryError::Malformed {
+                            format: "OBJ",
+                            message,
+                        },
+                        Some(k + 1),
+                    ));
+                }
+                continue;
+            }
+            _ => continue,
+        };
+        *count += 1;
+        if let Err(e) = limits::MESH_ELEMENTS.check(*count) {
+            let message = e.to_string().replace(limits::MESH_ELEMENTS.what, what);
+            return Err((
+                GeometryError::Malformed {
+                    format: "OBJ",
+                    message,
+                },
+                Some(k + 1),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A `v`/`vn`/`vt` line with a non-finite value: its line, its 0-based ordinal among
