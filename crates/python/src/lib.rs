@@ -17,6 +17,23 @@ mod toml_value;
 
 use pyo3::prelude::*;
 
+/// Raises (or lowers) a resource limit for this process, `"KEY=N"` as the CLI's
+/// `--limit`; an unknown key, a fixed limit or a value above the ceiling is a
+/// `ValueError` naming the valid keys or the ceiling.
+#[pyfunction]
+fn set_limit(assignment: &str) -> PyResult<()> {
+    facette_bsdf::limits::set_limit(assignment).map_err(errors::value_error)
+}
+
+/// Every resource limit: `(key, value in force, default, ceiling, what it counts)`.
+#[pyfunction]
+fn limits() -> Vec<(&'static str, u64, u64, u64, &'static str)> {
+    facette_bsdf::limits::all()
+        .iter()
+        .map(|l| (l.key, l.max(), l.default, l.ceiling, l.what))
+        .collect()
+}
+
 #[pymodule]
 fn _facette(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<material::Material>()?;
@@ -40,6 +57,11 @@ fn _facette(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parts::merge_table_parts, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_function(wrap_pyfunction!(fit::measure, m)?)?;
+    m.add_function(wrap_pyfunction!(set_limit, m)?)?;
+    m.add_function(wrap_pyfunction!(limits, m)?)?;
+    // `FACETTE_LIMITS` applies to Python as to the CLI (and reaches Ray workers through
+    // their environment); a bad value fails the import with the CLI's message.
+    facette_bsdf::limits::set_limits_from_env().map_err(errors::value_error)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

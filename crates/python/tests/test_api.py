@@ -244,3 +244,20 @@ def test_bad_arguments_never_panic(tiny_scene):
             call()
         except (ValueError, OSError, RuntimeError, TypeError, OverflowError) as e:
             assert type(e).__name__ != "PanicException", (k, e)
+
+
+def test_limits_are_raised_and_refused_like_the_cli():
+    limits = facette.limits()
+    value, default, ceiling, what = limits["xml-includes"]
+    assert (value, default) == (256, 256) and ceiling > default
+    facette.set_limit("xml-includes", 1000)
+    try:
+        assert facette.limits()["xml-includes"][0] == 1000
+    finally:
+        facette.set_limit("xml-includes", default)
+    with pytest.raises(ValueError, match="is fixed at 64"):
+        facette.set_limit("xml-depth", 100)
+    with pytest.raises(ValueError, match="unknown limit `nope`"):
+        facette.set_limit("nope", 1)
+    with pytest.raises(ValueError, match="must be an integer"):
+        facette.set_limit("xml-includes", 1.5)

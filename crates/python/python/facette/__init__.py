@@ -43,6 +43,8 @@ __all__ = [
     "merge_table_parts",
     "fit",
     "measure",
+    "set_limit",
+    "limits",
     "__version__",
 ]
 
@@ -468,3 +470,19 @@ def measure(material, path, noise=0.0, seed=1):
     if not isinstance(material, Material):
         material = Material(material)
     return _facette.measure(material._m, _os.fspath(path), float(noise), _count(seed, "seed"))
+
+
+def set_limit(key, value):
+    """Raises (or lowers) a resource limit for this process, as the CLI's ``--limit
+    KEY=N``: ``set_limit("mesh-elements", 2_000_000_000)``. Ray workers are other
+    processes: give them ``FACETTE_LIMITS="mesh-elements=2000000000"`` in their
+    environment instead (it is read at import). An unknown key, a fixed limit or a value
+    above the limit's ceiling raises ``ValueError``."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"set_limit: the value of `{key}` must be an integer, got {value!r}")
+    _facette.set_limit(f"{key}={value}")
+
+
+def limits():
+    """Every resource limit as a dict ``key -> (value in force, default, ceiling, what)``."""
+    return {k: (v, d, c, w) for (k, v, d, c, w) in _facette.limits()}
