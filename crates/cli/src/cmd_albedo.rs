@@ -35,14 +35,20 @@ pub fn run(a: AlbedoArgs) -> Result<ExitCode> {
     if !a.phi_i.is_finite() {
         bail!("--phi-i must be finite");
     }
+    // Every angle is checked before the first row is printed.
+    for &t in &a.theta_i {
+        if !(t.is_finite() && (0.0..=180.0).contains(&t)) || t == 90.0 {
+            bail!(
+                "--theta-i {}: expected an angle in [0, 180] degrees other than 90",
+                facette_bsdf::math::fmt_num(t)
+            );
+        }
+    }
     println!(
         "theta_i,reflectance_r,reflectance_g,reflectance_b,reflectance_se_r,reflectance_se_g,reflectance_se_b,\
 transmittance_r,transmittance_g,transmittance_b,transmittance_se_r,transmittance_se_g,transmittance_se_b"
     );
     for &t in &a.theta_i {
-        if !(t.is_finite() && (0.0..=180.0).contains(&t)) || t == 90.0 {
-            bail!("--theta-i {t}: expected an angle in [0, 180] degrees other than 90");
-        }
         // The light direction plays the role of `wo` in importance mode: the sampler then
         // draws the outgoing direction with weight f(i, o) |cos θ_o| / pdf.
         let wi = spherical_direction(t.to_radians(), a.phi_i.to_radians());

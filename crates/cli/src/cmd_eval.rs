@@ -79,7 +79,7 @@ pub fn parse_row(line: &str, lineno: usize, source: &str) -> Result<Option<[f64;
         if !(0.0..=180.0).contains(&v[k]) {
             bail!(
                 "{source}:{lineno}: {name} = {} is outside [0, 180] degrees",
-                v[k]
+                facette_bsdf::math::fmt_num(v[k])
             );
         }
     }

@@ -30,7 +30,7 @@ pub fn run(a: MeasureArgs) -> Result<ExitCode> {
     if !(a.noise.is_finite() && (0.0..=1.0).contains(&a.noise)) {
         bail!(
             "--noise {}: expected a relative deviation in [0, 1]",
-            a.noise
+            facette_bsdf::math::fmt_num(a.noise)
         );
     }
     crate::outputs::check_writable(&[("-o", &a.output)])?;

@@ -205,7 +205,10 @@ fn parse_choice<T>(
 
 fn check_theta(t: f64) -> Result<()> {
     if !(t.is_finite() && (0.0..90.0).contains(&t)) {
-        bail!("--theta-i {t}: expected an angle in [0, 90) degrees");
+        bail!(
+            "--theta-i {}: expected an angle in [0, 90) degrees",
+            facette_bsdf::math::fmt_num(t)
+        );
     }
     Ok(())
 }
@@ -413,7 +416,10 @@ fn plot_ndf(
 /// `plot albedo`: directional albedo against θ_i, every `step` degrees up to 89°.
 fn plot_albedo(m: &MaterialsArgs, step: f64) -> Result<()> {
     if !(0.5..=45.0).contains(&step) {
-        bail!("--step {step}: expected 0.5…45 degrees");
+        bail!(
+            "--step {}: expected 0.5…45 degrees",
+            facette_bsdf::math::fmt_num(step)
+        );
     }
     let mats = materials(m)?;
     let n = (89.0 / step).floor() as usize;

@@ -526,3 +526,35 @@ fn sky_colours_and_environment_maps_are_held_to_the_radiance_bound() {
     assert_clean_error(&o, "scale");
     assert!(!out.exists());
 }
+
+/// A 69-byte PNG whose header claims 100000 × 100000 pixels (valid CRCs).
+const HUGE_PNG: [u8; 69] = [
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44, 0x52,
+    0x00, 0x01, 0x86, 0xa0, 0x00, 0x01, 0x86, 0xa0, 0x08, 0x02, 0x00, 0x00, 0x00, 0x27, 0x30, 0x9c,
+    0x9f, 0x00, 0x00, 0x00, 0x0c, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0x60, 0xa0, 0x3d, 0x00,
+    0x00, 0x00, 0x64, 0x00, 0x01, 0x86, 0x64, 0x3c, 0x35, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e,
+    0x44, 0xae, 0x42, 0x60, 0x82,
+];
+
+#[test]
+fn png_headers_are_held_to_the_image_limit_before_decoding() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("huge.png"), HUGE_PNG).unwrap();
+    let scene = scene_file(
+        d.path(),
+        &SCENE.replace(
+            "type = \"constant\"\nradiance = 1.0",
+            "type = \"environment\"\nfile = \"huge.png\"",
+        ),
+    );
+    let out = d.path().join("x.exr");
+    let o = facette(&["render", s(&scene), "-o", s(&out)], None);
+    assert_clean_error(&o, "huge.png");
+    let e = stderr(&o);
+    assert!(
+        e.contains("100000 × 100000 = 10000000000 exceeds the limit of 268435456"),
+        "{e}"
+    );
+    assert!(e.contains("--limit image-pixels=N"), "{e}");
+    assert!(!out.exists());
+}

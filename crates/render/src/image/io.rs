@@ -137,7 +137,30 @@ fn decode_with_image_crate(path: &Path, format: FileFormat) -> Result<DynamicIma
         FileFormat::Png => ImageFormat::Png,
         _ => ImageFormat::Hdr,
     };
-    let reader = ImageReader::with_format(BufReader::new(file), image_format);
+    // The header's size is held to the image limits before any pixel is decoded, and
+    // the decoder may then allocate what that size needs (16 bytes per pixel covers
+    // 16-bit RGBA and f32 RGB), so raising `--limit image-pixels` reaches PNG and HDR too.
+    let dims = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        ImageReader::with_format(BufReader::new(&file), image_format).into_dimensions()
+    }));
+    let mut limits = image::Limits::default();
+    if let Ok(Ok((w, h))) = dims {
+        let too_large = |e: facette_bsdf::limits::LimitError| ImageError::Unsupported {
+            path: path.to_path_buf(),
+            format: format.name(),
+            reason: format!("{e} (or the header is damaged)"),
+        };
+        let pixels = facette_bsdf::limits::IMAGE_PIXELS
+            .check_product(&[w as u64, h as u64])
+            .map_err(too_large)?;
+        facette_bsdf::limits::IMAGE_SAMPLES
+            .check_product(&[pixels, 4])
+            .map_err(too_large)?;
+        limits.max_alloc = Some(limits.max_alloc.unwrap_or(0).max(pixels.saturating_mul(16)));
+    }
+    let file = File::open(path).map_err(|e| read_failure(path, e))?;
+    let mut reader = ImageReader::with_format(BufReader::new(file), image_format);
+    reader.limits(limits);
     // A decoder panic on malformed input must not take a render down with it.
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()));
     let corrupt = |reason: String| ImageError::Corrupt {
