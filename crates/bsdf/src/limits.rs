@@ -309,6 +309,12 @@ pub fn check_radiance(value: f64) -> Result<f64, String> {
 /// exposure of up to ±[`MAX_EXPOSURE_STOPS`] keeps pixels finite in f32.
 pub const MAX_RADIANCE: f64 = 1e15;
 
+/// The largest world-space coordinate of any object's bounds. Beyond it areas (2e30² is
+/// fine, 1e300² is not) and the BVH's f32 boxes (largest finite value 3.4e38) overflow,
+/// and a light's sampling density silently becomes 0: a rectangle scaled by 1e300 rendered
+/// 0.007 where its emission is 1. 1e30 m is far beyond the observable universe (4.4e26 m).
+pub const MAX_COORDINATE: f64 = 1e30;
+
 /// Entries of an IL body table, n_θ × n_θ × n_φ (8 bytes each: 800 MB). A 0.25° grid
 /// (94 million entries) fits.
 pub static TABLE_ENTRIES: Limit = Limit::new(

@@ -60,8 +60,12 @@ impl Sphere {
         if !center.is_finite() {
             return Err(param("center", format!("{center}"), "finite coordinates"));
         }
-        if !(radius > 0.0 && radius.is_finite()) {
-            return Err(param("radius", format!("{radius}"), "a finite number > 0"));
+        if !(radius > 0.0 && radius <= facette_bsdf::limits::MAX_COORDINATE) {
+            return Err(param(
+                "radius",
+                format!("{radius}"),
+                "a number > 0 and at most 1e30 (the scene coordinate limit)",
+            ));
         }
         let placed =
             *to_world * Transform::translate(center)? * Transform::scale(Vec3::splat(radius))?;

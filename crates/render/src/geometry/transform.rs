@@ -126,12 +126,21 @@ impl Transform {
         check_finite("look_at origin", origin)?;
         check_finite("look_at target", target)?;
         check_finite("look_at up", up)?;
+        for (name, p) in [("look_at origin", origin), ("look_at target", target)] {
+            if p.abs().max_element() > facette_bsdf::limits::MAX_COORDINATE {
+                return Err(GeometryError::InvalidTransformParameter {
+                    name,
+                    value: format!("{p}"),
+                    expected: "coordinates within ±1e30 (the scene coordinate limit)",
+                });
+            }
+        }
         let dir = (target - origin).normalize_or_zero();
         if dir == Vec3::ZERO {
             return Err(GeometryError::InvalidTransformParameter {
                 name: "look_at target",
                 value: format!("{target}"),
-                expected: "a point different from the origin",
+                expected: "a point different from the camera's position",
             });
         }
         let left = up.cross(dir).normalize_or_zero();

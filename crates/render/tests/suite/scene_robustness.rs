@@ -241,3 +241,33 @@ fn obj_faces_with_texture_indices_but_no_texture_coordinates_are_refused() {
     let e = mesh_error("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n");
     assert!(e.contains("`vn`"), "{e}");
 }
+
+#[test]
+fn objects_and_cameras_beyond_the_coordinate_limit_are_refused() {
+    // A rectangle scaled by 1e300 has an infinite area: its emission rendered 0.007
+    // instead of 1 before this limit.
+    let e = toml_error(&TOML_SCENE.replace(
+        "[[lights]]",
+        "[[objects]]\nshape = \"rectangle\"\ntransform = [{scale = 1e300}]\nemission = 1\nmaterial = { type = \"lambert\" }\n\n[[lights]]",
+    ));
+    assert!(
+        e.contains("s.toml:") && e.contains("coordinate limit 1e30"),
+        "{e}"
+    );
+    let e = toml_error(&TOML_SCENE.replace("radius = 1", "radius = 1e308"));
+    assert!(e.contains("`radius`") && e.contains("1e30"), "{e}");
+    let e = toml_error(&TOML_SCENE.replace("position = [0, 0, 4]", "position = [0, 0, 1e200]"));
+    assert!(e.contains("look_at origin") && e.contains("±1e30"), "{e}");
+    // Within the limit, a huge emitter still renders its emission.
+    let ok = toml_error_or_ok(&TOML_SCENE.replace(
+        "[[lights]]",
+        "[[objects]]\nshape = \"rectangle\"\ntransform = [{scale = 1e29}]\nemission = 1\nmaterial = { type = \"lambert\" }\n\n[[lights]]",
+    ));
+    assert!(ok.is_none(), "{ok:?}");
+}
+
+fn toml_error_or_ok(text: &str) -> Option<String> {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(d.path(), "s.toml", text);
+    load_scene(&p).err().map(|e| e.to_string())
+}

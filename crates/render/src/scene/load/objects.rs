@@ -82,7 +82,7 @@ fn create_shape(
     e: &dyn Fn(String) -> SceneError,
 ) -> Result<Shape, SceneError> {
     let geometry = |x: GeometryError| e(x.to_string());
-    Ok(match o.shape.as_str() {
+    let shape = match o.shape.as_str() {
         "sphere" => {
             let center = o.center.map(vec3).unwrap_or(Vec3::ZERO);
             let radius = o.radius.unwrap_or(1.0);
@@ -111,7 +111,17 @@ fn create_shape(
                 .map_err(geometry)?;
             Shape::Mesh(Arc::new(mesh))
         }
-    })
+    };
+    let b = shape.bounds();
+    let reach = b.min.abs().max(b.max.abs()).max_element();
+    if !(reach <= facette_bsdf::limits::MAX_COORDINATE) {
+        return Err(e(format!(
+            "the object reaches {} in world space, beyond the coordinate limit {:e} (areas and bounding boxes would overflow); scale the scene down",
+            facette_bsdf::math::fmt_num(reach),
+            facette_bsdf::limits::MAX_COORDINATE
+        )));
+    }
+    Ok(shape)
 }
 
 /// The OBJ or PLY mesh of `o`, with the normals it asks for.
