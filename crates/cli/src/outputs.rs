@@ -18,6 +18,22 @@ pub fn check_writable(outputs: &[(&str, &Path)]) -> Result<()> {
     for (option, path) in outputs {
         check_one(option, path)?;
     }
+    // Two options naming one file: the second write would replace the first.
+    let key = |p: &Path| {
+        let dir = std::fs::canonicalize(parent_dir(p)).unwrap_or_else(|_| parent_dir(p).into());
+        dir.join(p.file_name().unwrap_or_default())
+    };
+    for (i, (a, pa)) in outputs.iter().enumerate() {
+        for (b, pb) in &outputs[i + 1..] {
+            if key(pa) == key(pb) {
+                bail!(
+                    "{a} {} and {b} {} name the same file: the second would replace the first (nothing was written)",
+                    pa.display(),
+                    pb.display()
+                );
+            }
+        }
+    }
     Ok(())
 }
 
@@ -131,6 +147,16 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().contains("--csv no/dir/p.csv"), "{e}");
         assert!(check_writable(&[("-o", Path::new("."))]).is_err());
+    }
+
+    #[test]
+    fn two_options_naming_one_file_are_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let a = d.path().join("p.svg");
+        let b = d.path().join(".").join("p.svg");
+        let e = check_writable(&[("-o", &a), ("--csv", &b)]).unwrap_err();
+        assert!(e.to_string().contains("name the same file"), "{e}");
+        check_writable(&[("-o", &a), ("--csv", &d.path().join("p.csv"))]).unwrap();
     }
 
     #[test]
