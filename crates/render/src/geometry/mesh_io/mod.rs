@@ -12,6 +12,8 @@
 
 pub mod obj;
 pub mod ply;
+#[cfg(test)]
+mod ply_rs_reader;
 
 use super::error::{GeometryError, GeometryResult};
 use super::mesh_data::MeshData;
