@@ -13,13 +13,13 @@
 //! `u64` and made one record per declared element of an element without properties (a
 //! 70-byte file could ask for 10^12); its fork `ply-rs-bw` 4 fixes the panics and caps
 //! preallocation, but still loops over such an element (10^8 records of nothing: 11 s,
-//! 7 GB) and reads the whole file into one map per record (docs/validation.md,
-//! "Robustness", has the measurements). Here every count is checked against
-//! [`limits::MESH_ELEMENTS`] and against the bytes (binary) or lines (ASCII) left after
-//! the header before anything is allocated; a binary record's list is checked against the
-//! bytes left before it is read; arithmetic on counts is checked; nothing indexes a slice
-//! unchecked. Errors name the file and, for ASCII, the line; for binary, the element and
-//! record.
+//! 7 GB) and builds a record per element before the caller sees any (docs/validation.md,
+//! "Robustness", has the measurements: this reader is also 2–5 times faster). Here every
+//! count is checked against [`limits::MESH_ELEMENTS`] and against the bytes (binary) or
+//! lines (ASCII) left after the header before anything is allocated; a binary record's
+//! list is checked against the bytes left before it is read; arithmetic on counts is
+//! checked; slices are indexed only where a bound was checked. Errors name the file and,
+//! for ASCII, the line; for binary, the element and record.
 
 use crate::geometry::error::{GeometryError, GeometryResult};
 use crate::geometry::mesh_data::MeshData;
