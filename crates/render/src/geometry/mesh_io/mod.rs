@@ -1,5 +1,5 @@
-//! Mesh files: Wavefront OBJ (through `tobj`) and PLY (through `ply-rs`), ASCII and
-//! binary.
+//! Mesh files: Wavefront OBJ (through `tobj`) and PLY (a bounded reader of our own, see
+//! [`ply`]), ASCII and binary.
 //!
 //! Readers return [`MeshData`] — one mesh per file, every group/object merged — and
 //! report errors with the file's path and, when it can be known, the line:
