@@ -7,7 +7,10 @@
 //!   `coherent` rays come from a pinhole camera framing the mesh (256×256), `incoherent`
 //!   ones start at random points of the bounding box in random directions (as diffuse
 //!   bounces do);
-//! - `occluded/<size>/incoherent/<threads>`: the any-hit query on the incoherent rays.
+//! - `occluded/<size>/incoherent/<threads>`: the any-hit query on the incoherent rays;
+//! - `ply_load/<format>`: `read_ply` of a 1M-triangle grid (708 × 708 vertices with
+//!   normals and uvs) in binary little-endian (29 MB) and ASCII, from the page cache;
+//!   throughput in bytes/s.
 //!
 //! Short measurement times keep the whole run to a few minutes:
 //! `cargo bench -p facette-render --bench geometry`. Results are recorded in the
@@ -17,6 +20,7 @@ use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criteri
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::math::warp::square_to_uniform_sphere;
 use facette_render::geometry::generate::TorusKnot;
+use facette_render::geometry::mesh_io::read_ply;
 use facette_render::geometry::{Ray, SceneGeometry, Shape, Transform, Vec3};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -150,5 +154,65 @@ fn bench_trace(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_build, bench_trace);
+/// A 1M-triangle grid as PLY text or binary little-endian: `n × n` vertices (position,
+/// normal, uv as f32), two triangles per cell (uchar count, int indices).
+fn grid_ply(n: usize, binary: bool) -> Vec<u8> {
+    let format = if binary {
+        "binary_little_endian"
+    } else {
+        "ascii"
+    };
+    let mut out = format!(
+        "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        n * n,
+        2 * (n - 1) * (n - 1)
+    )
+    .into_bytes();
+    for j in 0..n {
+        for i in 0..n {
+            let (u, v) = (i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32);
+            let values = [u, v, (u * 7.0).sin() * 0.1, 0.0, 0.0, 1.0, u, v];
+            if binary {
+                values.iter().for_each(|x| out.extend(x.to_le_bytes()));
+            } else {
+                let line: Vec<String> = values.iter().map(f32::to_string).collect();
+                out.extend(line.join(" ").bytes());
+                out.push(b'\n');
+            }
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = (j * n + i) as i32;
+            let n = n as i32;
+            for t in [[a, a + 1, a + n], [a + 1, a + n + 1, a + n]] {
+                if binary {
+                    out.push(3);
+                    t.iter().for_each(|x| out.extend(x.to_le_bytes()));
+                } else {
+                    out.extend(format!("3 {} {} {}\n", t[0], t[1], t[2]).bytes());
+                }
+            }
+        }
+    }
+    out
+}
+
+fn bench_ply_load(c: &mut Criterion) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let mut g = c.benchmark_group("ply_load");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    for (name, binary) in [("binary_le", true), ("ascii", false)] {
+        let bytes = grid_ply(708, binary);
+        let path = dir.path().join(format!("grid-{name}.ply"));
+        std::fs::write(&path, &bytes).expect("written");
+        g.throughput(Throughput::Bytes(bytes.len() as u64));
+        g.bench_function(name, |b| {
+            b.iter(|| read_ply(black_box(&path)).expect("valid PLY"))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_build, bench_trace, bench_ply_load);
 criterion_main!(benches);

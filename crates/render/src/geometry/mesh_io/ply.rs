@@ -29,6 +29,16 @@ use std::path::Path;
 
 /// Reads a PLY file.
 pub fn read_ply(path: &Path) -> GeometryResult<MeshData> {
+    // The size is checked before the file is read into memory.
+    if let Ok(m) = std::fs::metadata(path) {
+        limits::MESH_FILE_BYTES.check(m.len()).map_err(|e| {
+            GeometryError::Malformed {
+                format: "PLY",
+                message: e.to_string(),
+            }
+            .in_file(path, None)
+        })?;
+    }
     let bytes = std::fs::read(path).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
@@ -603,7 +613,7 @@ fn parse_ply(bytes: &[u8]) -> Result<MeshData, Failure> {
         has_normals,
         has_uvs,
         vertex_count,
-        max_indices: 3 * limits::MESH_ELEMENTS.max as usize,
+        max_indices: 3 * limits::MESH_ELEMENTS.max() as usize,
     };
     let mut at = Cursor {
         pos: 0,
@@ -1448,83 +1458,5 @@ mod tests {
                 Ok(())
             })
             .unwrap();
-    }
-
-    /// Load time of a 1M-triangle mesh (a 708 × 708 grid with normals and uvs) in binary
-    /// little-endian and ASCII, from memory. Run it with `cargo test --profile optimized-tests --workspace --lib
-    /// ply_load_speed -- --ignored --nocapture`; docs/validation.md has the numbers.
-    #[test]
-    #[ignore = "a measurement, not a check"]
-    fn ply_load_speed() {
-        let n = 708usize;
-        for enc in [Enc::Le, Enc::Ascii] {
-            let l = Layout { enc, ..PLAIN };
-            let format = if enc == Enc::Ascii {
-                "ascii"
-            } else {
-                "binary_little_endian"
-            };
-            let mut out = format!(
-                "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
-                n * n,
-                2 * (n - 1) * (n - 1)
-            )
-            .into_bytes();
-            for j in 0..n {
-                for i in 0..n {
-                    let (u, v) = (i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32);
-                    let mut r = Record {
-                        enc: l.enc,
-                        out: &mut out,
-                        first: true,
-                    };
-                    for c in [u, v, (u * 7.0).sin() * 0.1, 0.0, 0.0, 1.0, u, v] {
-                        r.put(Scalar::F32, c as f64);
-                    }
-                    r.end();
-                }
-            }
-            for j in 0..n - 1 {
-                for i in 0..n - 1 {
-                    let a = (j * n + i) as f64;
-                    for t in [
-                        [a, a + 1.0, a + n as f64],
-                        [a + 1.0, a + n as f64 + 1.0, a + n as f64],
-                    ] {
-                        let mut r = Record {
-                            enc: l.enc,
-                            out: &mut out,
-                            first: true,
-                        };
-                        r.put(Scalar::U8, 3.0);
-                        for x in t {
-                            r.put(Scalar::I32, x);
-                        }
-                        r.end();
-                    }
-                }
-            }
-            let mb = out.len() as f64 / 1e6;
-            let time = |f: &dyn Fn() -> MeshData| {
-                let mut t: Vec<f64> = (0..5)
-                    .map(|_| {
-                        let start = std::time::Instant::now();
-                        let d = f();
-                        let s = start.elapsed().as_secs_f64();
-                        assert_eq!(d.indices.len(), 6 * (n - 1) * (n - 1));
-                        s
-                    })
-                    .collect();
-                t.sort_by(f64::total_cmp);
-                (t[0], t[2])
-            };
-            let (best, median) = time(&|| parse_ply(&out).unwrap());
-            println!(
-                "{format} {mb:.1} MB: best {:.0} ms, median {:.0} ms ({:.0} MB/s)",
-                best * 1e3,
-                median * 1e3,
-                mb / median
-            );
-        }
     }
 }
