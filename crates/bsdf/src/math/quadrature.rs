@@ -137,7 +137,7 @@ pub(crate) const GK15_NODES: usize = 15;
 /// K15 on [a, b] of an integrand that returns (value, its own error): (K15 value, the
 /// error estimate of QUADPACK's QK15, the K15-weighted sum of the own errors).
 ///
-/// QK15's estimate [Piessens et al. 1983, §2.2.1] scales |K15 − G7| with the K15 integral
+/// QK15's estimate [Piessens et al. 1983] scales |K15 − G7| with the K15 integral
 /// of |f − mean|, r: e = r·min(1, (200 |K15 − G7| / r)^1.5), at least 50 ε ∫|f|. Where
 /// the two rules are far from agreeing (a kink or a peak they do not resolve, where they
 /// err alike and their difference can be smaller than either error) it is close to r, a
