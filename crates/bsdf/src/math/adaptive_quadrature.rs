@@ -283,9 +283,12 @@ mod tests {
         }
     }
 
+    /// (a, b, f, ∫_a^b f).
+    type Case = (f64, f64, fn(f64) -> f64, f64);
+
     #[test]
     fn smooth_functions_to_1e12() {
-        let cases: [(f64, f64, fn(f64) -> f64, f64); 4] = [
+        let cases: [Case; 4] = [
             (0.0, PI, f64::sin, 2.0),
             (0.0, 1.0, f64::exp, std::f64::consts::E - 1.0),
             (
