@@ -4,7 +4,13 @@
 //! direction, both pointing away from the surface; z is the normal, φ from the tangent x
 //! axis; θ > 90° is below the surface, i.e. transmission). A header line is optional, `#`
 //! starts a comment. Output rows `theta_i,phi_i,theta_o,phi_o,r,g,b` with f(i, o) without
-//! the cosine factor (delta lobes excluded).
+//! the cosine factor (delta lobes excluded). With `--with-error`, three more columns
+//! `err_r,err_g,err_b`: the adaptive quadrature's error estimate where the value is one
+//! (`evaluation = "quadrature"`), the standard error where it is a mean of stochastic
+//! estimates (or of a fixed set of `samples = N` microfacets, over its 8 rotations), the
+//! root sum of squares where a value adds both (IL with V-cavity inter-reflections), and 0
+//! for closed forms and tabulated values (a table's own interpolation error is not
+//! known to eval).
 
 use crate::material_arg::parse_material_at;
 use anyhow::{bail, Context, Result};
@@ -44,6 +50,10 @@ pub struct EvalArgs {
     /// in texels; correlation).
     #[arg(long, value_name = "U,V,SIGMA")]
     footprint: Option<String>,
+    /// Add columns err_r,err_g,err_b: the quadrature's error estimate, or the standard error
+    /// of stochastic values, 0 for closed forms.
+    #[arg(long)]
+    with_error: bool,
 }
 
 /// Parses one data row; `Ok(None)` for blank lines, comments and a header.
@@ -116,7 +126,11 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
     let mut rng = Pcg32::new(a.seed, 0);
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
-    writeln!(out, "theta_i,phi_i,theta_o,phi_o,r,g,b")?;
+    if a.with_error {
+        writeln!(out, "theta_i,phi_i,theta_o,phi_o,r,g,b,err_r,err_g,err_b")?;
+    } else {
+        writeln!(out, "theta_i,phi_i,theta_o,phi_o,r,g,b")?;
+    }
     for (k, line) in reader.lines().enumerate() {
         let line = line.with_context(|| format!("{source}:{}: unreadable line", k + 1))?;
         let Some([ti, pi, to, po]) = parse_row(&line, k + 1, &source)? else {
@@ -124,12 +138,16 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         };
         let wi = spherical_direction(ti.to_radians(), pi.to_radians());
         let wo = spherical_direction(to.to_radians(), po.to_radians());
-        let (f, _) = bsdf.eval_estimate(wo, wi, &ctx, a.samples, &mut rng);
-        writeln!(
+        let (f, err) = bsdf.eval_estimate(wo, wi, &ctx, a.samples, &mut rng);
+        write!(
             out,
             "{ti},{pi},{to},{po},{:.9e},{:.9e},{:.9e}",
             f[0], f[1], f[2]
         )?;
+        if a.with_error {
+            write!(out, ",{:.3e},{:.3e},{:.3e}", err[0], err[1], err[2])?;
+        }
+        writeln!(out)?;
     }
     out.flush()?;
     Ok(ExitCode::SUCCESS)

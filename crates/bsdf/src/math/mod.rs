@@ -7,6 +7,7 @@
 //! the same as `f32`; one type keeps every code path identical between the renderer and
 //! the checks that prove it.
 
+pub mod adaptive_quadrature;
 pub mod complex;
 pub(crate) mod cosine_lobe;
 pub mod quadrature;

@@ -15,8 +15,9 @@
 //! | `reflectance` | facet albedo K_d (number or RGB) | [0, 1] | 0.5 |
 //! | `sigma` | Gaussian roughness, radians | (0, π/2) (0 = Lambert) | required |
 //! | `model` | `exact`, `qualitative` or `l1` | — | `exact` |
-//! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (N microfacets, deterministic) | — | `quadrature` |
-//! | `samples` | exact, quadrature: microfacets per evaluation | ≥ 8 | 256 |
+//! | `evaluation` | exact only: `stochastic` (one microfacet per call, unbiased) or `quadrature` (deterministic: adaptive to `tolerance`, or N microfacets with `samples`) | — | `quadrature` |
+//! | `tolerance` | exact, quadrature: relative tolerance of the adaptive quadrature | [1e-12, 0.1] | 1e-6 |
+//! | `samples` | exact, quadrature: a fixed set of N microfacets per evaluation | ≥ 8 | 256 when none of `evaluation`, `tolerance`, `samples` is given |
 
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
@@ -27,18 +28,21 @@ use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
-use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
+use crate::microfacet::integral::{check_tolerance, MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::{Gaussian, Masking, Ndf};
 use crate::two_sided::OpaqueBsdf;
 
 /// How a model estimates its microfacet integral.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum IntegralEvaluation {
     /// One microfacet per evaluation: unbiased, noisy, what a path tracer uses.
     Stochastic,
     /// A fixed set of N microfacets (randomized QMC frozen at construction): deterministic,
     /// exactly reciprocal, with a standard error.
     Quadrature { samples: usize },
+    /// Adaptive Gauss–Kronrod quadrature to a relative tolerance, with its error estimate:
+    /// deterministic, exactly reciprocal.
+    Adaptive { tolerance: f64 },
 }
 
 impl IntegralEvaluation {
@@ -64,6 +68,9 @@ impl OrenNayarExact {
         if let IntegralEvaluation::Quadrature { samples } = evaluation {
             check_min_count("samples", samples, 8)?;
         }
+        if let IntegralEvaluation::Adaptive { tolerance } = evaluation {
+            check_tolerance(tolerance)?;
+        }
         Ok(OrenNayarExact {
             reflectance,
             sigma,
@@ -75,8 +82,8 @@ impl OrenNayarExact {
         })
     }
 
-    /// The microfacet integral ∫ D G |im||om|/(|in||on|) dω (without K_d/π) and its
-    /// standard error.
+    /// The microfacet integral ∫ D G |im||om|/(|in||on|) dω (without K_d/π) [IL18 eq. 3]
+    /// and its standard error or quadrature error estimate.
     fn integral_value(&self, i: Vec3, o: Vec3, rng: &mut dyn RandomSource) -> (f64, f64) {
         match self.evaluation {
             IntegralEvaluation::Stochastic => (
@@ -86,6 +93,10 @@ impl OrenNayarExact {
             IntegralEvaluation::Quadrature { samples } => {
                 self.integral
                     .estimate(i, o, samples, &mut Pcg32::new(QUADRATURE_SEED, 0), |_| 1.0)
+            }
+            IntegralEvaluation::Adaptive { tolerance } => {
+                let q = self.integral.integrate(i, o, tolerance, |_| 1.0);
+                (q.value, q.error)
             }
         }
     }
@@ -114,7 +125,9 @@ impl OpaqueBsdf for OrenNayarExact {
     ) -> (Spectrum, Spectrum) {
         let (o, i) = (wo, wi);
         let (v, se) = match self.evaluation {
-            IntegralEvaluation::Quadrature { .. } => self.integral_value(i, o, rng),
+            IntegralEvaluation::Quadrature { .. } | IntegralEvaluation::Adaptive { .. } => {
+                self.integral_value(i, o, rng)
+            }
             IntegralEvaluation::Stochastic => {
                 let (m, se) = crate::bsdf::mean_and_stderr(samples, || {
                     Spectrum::splat(self.integral.estimate_one(i, o, rng.next_2d(), |_| 1.0))
@@ -146,6 +159,9 @@ impl OpaqueBsdf for OrenNayarExact {
         let e = match self.evaluation {
             IntegralEvaluation::Stochastic => "stochastic".to_string(),
             IntegralEvaluation::Quadrature { samples } => format!("quadrature {samples}"),
+            IntegralEvaluation::Adaptive { tolerance } => {
+                format!("quadrature tolerance {}", fmt_num(tolerance))
+            }
         };
         format!(
             "oren-nayar exact(reflectance={:?}, sigma={}, {e})",

@@ -351,3 +351,100 @@ fn output_into_a_closed_pipe_exits_quietly() {
     assert_eq!(o.status.code(), Some(141), "{}", stderr(&o));
     assert!(stderr(&o).is_empty(), "{}", stderr(&o));
 }
+
+#[test]
+fn eval_with_error_prints_the_quadrature_error_or_the_standard_error() {
+    // Beckmann α = 0.7, n_i = 1, at a grazing pair: the reference of IL18 eqs. 4 + 13 from
+    // scripts/il_reference.py (crates/bsdf/tests/suite/il_quadrature_reference.rs).
+    let reference = 0.021_810_921_655_075_52;
+    let il = r#"{type = "il", kd = 0.8, ni = 1.0, distribution = "beckmann", alpha = 0.7, masking = "v-cavity", evaluation = "quadrature"}"#;
+    let pair = "85,0,85,180\n";
+    let o = facette(&["eval", "--material", il, "--with-error"], Some(pair));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).starts_with("theta_i,phi_i,theta_o,phi_o,r,g,b,err_r,err_g,err_b\n"));
+    let r = rows(&o);
+    assert_eq!(r[0].len(), 10);
+    let (f, err) = (r[0][4], r[0][7]);
+    assert!(err > 0.0 && err <= 1e-6 * f, "{f} ± {err}");
+    assert!(
+        (f - reference).abs() <= err.max(1e-9 * reference),
+        "{f} ± {err} vs {reference}"
+    );
+    // Without the flag: the seven columns, the same value.
+    let o = facette(&["eval", "--material", il], Some(pair));
+    assert_eq!(
+        stdout(&o).lines().next(),
+        Some("theta_i,phi_i,theta_o,phi_o,r,g,b")
+    );
+    assert_eq!(rows(&o)[0], r[0][..7].to_vec());
+    // Stochastic: the standard error of the mean of the estimates, consistent with the
+    // reference.
+    let stochastic = il.replace("\"quadrature\"", "\"stochastic\"");
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            &stochastic,
+            "--with-error",
+            "--samples",
+            "20000",
+        ],
+        Some(pair),
+    );
+    let r = rows(&o);
+    let (f, se) = (r[0][4], r[0][7]);
+    assert!(se > 0.0 && se < 0.05 * f, "{f} ± {se}");
+    assert!(
+        (f - reference).abs() < 5.0 * se,
+        "{f} ± {se} vs {reference}"
+    );
+    // Closed forms: 0.
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "lambert"}"#,
+            "--with-error",
+        ],
+        Some(pair),
+    );
+    assert_eq!(rows(&o)[0][7..], [0.0, 0.0, 0.0]);
+}
+
+#[test]
+fn quadrature_keys_are_checked_by_name() {
+    let base = r#"type = "il", distribution = "beckmann", alpha = 0.3"#;
+    for (extra, expect) in [
+        (
+            r#"evaluation = "quadrature", samples = 64, tolerance = 1e-4"#,
+            "exclusive",
+        ),
+        (r#"evaluation = "quadrature", tolerance = 0.5"#, "tolerance"),
+        (
+            r#"evaluation = "stochastic", tolerance = 1e-4"#,
+            "`tolerance` applies to",
+        ),
+        (
+            r#"evaluation = "quadrature", tolerances = 1e-4"#,
+            "tolerance",
+        ),
+    ] {
+        let m = format!("{{{base}, {extra}}}");
+        let o = facette(&["eval", "--material", &m], Some("30,0,30,180\n"));
+        assert!(!o.status.success(), "{m}");
+        assert!(stderr(&o).contains(expect), "{m}: {}", stderr(&o));
+    }
+    // Oren–Nayar: the same keys.
+    let o = facette(
+        &[
+            "eval",
+            "--material",
+            r#"{type = "oren-nayar", sigma = 0.3, evaluation = "quadrature", tolerance = 1e-8}"#,
+            "--with-error",
+        ],
+        Some("60,0,60,0\n"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = rows(&o);
+    assert!(r[0][7] > 0.0 && r[0][7] <= 1e-8 * r[0][4], "{:?}", r[0]);
+}

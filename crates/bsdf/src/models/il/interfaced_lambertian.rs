@@ -14,8 +14,9 @@
 //!   with any distribution and masking of the core (IL18 Table 2).
 //!
 //! The body integral is evaluated four ways ([`BodyEvaluation`]): *stochastic* — one
-//! microfacet per call, unbiased, IL18 eq. 28; *quadrature* — N microfacets, TSBRM eq. 37,
-//! with its standard error; *table* — TSBRM §4.3's (θ_i, θ_o, φ_o) grid, trilinear; *approx*
+//! microfacet per call, unbiased, IL18 eq. 28; *quadrature* — adaptive Gauss–Kronrod over
+//! the hemisphere of normals to a relative tolerance, with its error estimate (or, with
+//! `samples = N`, N microfacets, TSBRM eq. 37, with their standard error); *table* — TSBRM §4.3's (θ_i, θ_o, φ_o) grid, trilinear; *approx*
 //! — the closed form of IL18 §4.2 (see `il_approx`).
 //!
 //! **Sampling**  [IL18 §4.1]: the specular lobe with probability R_s/(R_s + R_b), R_s = r_e,
@@ -46,7 +47,7 @@ use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI};
-use crate::microfacet::integral::{MicrofacetIntegral, QUADRATURE_SEED};
+use crate::microfacet::integral::{check_tolerance, MicrofacetIntegral, QUADRATURE_SEED};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
 use crate::two_sided::OpaqueBsdf;
@@ -57,8 +58,11 @@ use std::sync::Arc;
 pub enum BodyEvaluation {
     /// One microfacet per call [IL18 eq. 28].
     Stochastic,
-    /// N microfacets, deterministic [TSBRM eq. 37].
+    /// N microfacets, deterministic [TSBRM eq. 37] (`samples = N`).
     Quadrature { samples: usize },
+    /// Adaptive Gauss–Kronrod quadrature of [IL18 eq. 13] to a relative tolerance, with
+    /// its error estimate (`evaluation = "quadrature"` without `samples`).
+    Adaptive { tolerance: f64 },
     /// The tabulated body integral [TSBRM §4.3].
     Table(Arc<BodyTable>),
     /// The approximate closed form [IL18 §4.2].
@@ -71,7 +75,7 @@ impl BodyEvaluation {
     pub fn name(&self) -> &'static str {
         match self {
             BodyEvaluation::Stochastic => "stochastic",
-            BodyEvaluation::Quadrature { .. } => "quadrature",
+            BodyEvaluation::Quadrature { .. } | BodyEvaluation::Adaptive { .. } => "quadrature",
             BodyEvaluation::Table(_) => "table",
             BodyEvaluation::Approx(_) => "approx",
         }
@@ -146,6 +150,9 @@ impl InterfacedLambertian {
         let body_factor = kd.map(|k| k / (ni * ni * (1.0 - k * ri)));
         if let BodyEvaluation::Quadrature { samples } = evaluation {
             check_min_count("samples", samples, 8)?;
+        }
+        if let BodyEvaluation::Adaptive { tolerance } = evaluation {
+            check_tolerance(tolerance)?;
         }
         let integral = match &lobe {
             Some(l) => Some(MicrofacetIntegral::new(l.ndf.clone(), l.masking)?),
@@ -226,7 +233,8 @@ impl InterfacedLambertian {
     }
 
     /// The body integral I(i, o) = ∫ T T D G |im||om|/(|in||on|) dω (IL18 eq. 13 without its
-    /// prefactor) by the model's evaluation mode, with its standard error where known.
+    /// prefactor) by the model's evaluation mode, with its standard error (stochastic,
+    /// fixed-N quadrature) or the adaptive quadrature's error estimate, where known.
     /// `samples` > 0 asks stochastic evaluation for an average of that many estimates.
     pub fn body_integral(
         &self,
@@ -254,6 +262,10 @@ impl InterfacedLambertian {
             }
             BodyEvaluation::Quadrature { samples } => {
                 integral.estimate(i, o, *samples, &mut Pcg32::new(QUADRATURE_SEED, 1), h)
+            }
+            BodyEvaluation::Adaptive { tolerance } => {
+                let q = integral.integrate(i, o, *tolerance, h);
+                (q.value, q.error)
             }
             BodyEvaluation::Table(t) => (t.lookup(i, o), 0.0),
             BodyEvaluation::Approx(a) => (a.body_integral(i, o, self.ni, self.re), 0.0),
@@ -431,6 +443,9 @@ impl OpaqueBsdf for InterfacedLambertian {
         };
         let ev = match &self.evaluation {
             BodyEvaluation::Quadrature { samples } => format!("quadrature {samples}"),
+            BodyEvaluation::Adaptive { tolerance } => {
+                format!("quadrature tolerance {}", fmt_num(*tolerance))
+            }
             e => e.name().to_string(),
         };
         format!(

@@ -5,6 +5,7 @@ use super::{keys, MaterialRecipe};
 use crate::bsdf::Bsdf;
 use crate::error::{ParamError, ParamResult};
 use crate::math::spectrum::Spectrum;
+use crate::microfacet::integral::{check_tolerance, DEFAULT_TOLERANCE};
 use crate::models::oren_nayar::IntegralEvaluation;
 use crate::models::{Lambert, OrenNayarExact, OrenNayarQualitative};
 use crate::recipe::params::{choice, Params};
@@ -12,8 +13,14 @@ use crate::two_sided::TwoSided;
 use std::sync::Arc;
 
 pub(super) const LAMBERT_KEYS: &[&str] = &["reflectance"];
-pub(super) const OREN_NAYAR_KEYS: &[&str] =
-    &["reflectance", "sigma", "model", "evaluation", "samples"];
+pub(super) const OREN_NAYAR_KEYS: &[&str] = &[
+    "reflectance",
+    "sigma",
+    "model",
+    "evaluation",
+    "samples",
+    "tolerance",
+];
 
 /// Oren–Nayar variants.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -30,21 +37,38 @@ pub(super) fn parse_lambert(p: &Params) -> ParamResult<MaterialRecipe> {
     Ok(MaterialRecipe::Lambert { reflectance: r })
 }
 
-/// `evaluation` and `samples` keys of models with a microfacet integral.
+/// `evaluation`, `samples` and `tolerance` keys of models with a microfacet integral:
+/// "quadrature" is adaptive to `tolerance` (default 1e-6) unless `samples = N` asks for a
+/// fixed set of N microfacets; when none of the three keys is given, the fixed set of
+/// `default_samples` microfacets (the cheaper choice for rendering).
 pub fn parse_evaluation(p: &Params, default_samples: usize) -> ParamResult<IntegralEvaluation> {
     let samples = p.count("samples")?;
-    match p.str("evaluation")?.unwrap_or("quadrature") {
+    let tolerance = p.f64("tolerance")?;
+    let given = p.str("evaluation")?;
+    match given.unwrap_or("quadrature") {
         "stochastic" => {
-            if samples.is_some() {
-                return Err(ParamError::Invalid(
-                    "`samples` applies to evaluation = \"quadrature\"".into(),
-                ));
+            for (key, set) in [
+                ("samples", samples.is_some()),
+                ("tolerance", tolerance.is_some()),
+            ] {
+                if set {
+                    return Err(ParamError::Invalid(format!(
+                        "`{key}` applies to evaluation = \"quadrature\""
+                    )));
+                }
             }
             Ok(IntegralEvaluation::Stochastic)
         }
-        "quadrature" => Ok(IntegralEvaluation::Quadrature {
-            samples: samples.unwrap_or(default_samples),
-        }),
+        "quadrature" => match (samples, tolerance) {
+            (Some(_), Some(_)) => Err(super::il::samples_and_tolerance()),
+            (Some(n), None) => Ok(IntegralEvaluation::Quadrature { samples: n }),
+            (None, None) if given.is_none() => Ok(IntegralEvaluation::Quadrature {
+                samples: default_samples,
+            }),
+            (None, t) => Ok(IntegralEvaluation::Adaptive {
+                tolerance: check_tolerance(t.unwrap_or(DEFAULT_TOLERANCE))?,
+            }),
+        },
         other => Err(choice("evaluation", other, IntegralEvaluation::NAMES)),
     }
 }

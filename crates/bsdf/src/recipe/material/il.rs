@@ -6,6 +6,7 @@ use super::{keys, MaterialRecipe};
 use crate::bsdf::Bsdf;
 use crate::error::{ParamError, ParamResult};
 use crate::math::spectrum::Spectrum;
+use crate::microfacet::integral::{check_tolerance, DEFAULT_TOLERANCE};
 use crate::microfacet::specular_lobe::{NormalSampling, SpecularLobe};
 use crate::microfacet::Masking;
 use crate::models::il::il_approx::IlApprox;
@@ -17,14 +18,27 @@ use crate::recipe::params::{choice, Params};
 use crate::two_sided::TwoSided;
 use std::sync::Arc;
 
-pub(super) const IL_KEYS: &[&str] = &["kd", "ni", "evaluation", "samples", "table", "scattering"];
+pub(super) const IL_KEYS: &[&str] = &[
+    "kd",
+    "ni",
+    "evaluation",
+    "samples",
+    "tolerance",
+    "table",
+    "scattering",
+];
 
 /// How an interfaced-Lambertian recipe evaluates its body term.
 #[derive(Clone, Debug)]
 pub enum IlEvaluation {
     Stochastic,
+    /// `samples = N`: a fixed set of N microfacets.
     Quadrature {
         samples: usize,
+    },
+    /// Adaptive quadrature to a relative tolerance (the default of "quadrature").
+    Adaptive {
+        tolerance: f64,
     },
     Table(Arc<BodyTable>),
     /// The approximation's coefficients are looked up at build time (they depend on the
@@ -47,6 +61,7 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
         Some(s) => NormalSampling::parse(s)?,
     };
     let samples = p.count("samples")?;
+    let tolerance = p.f64("tolerance")?;
     let table_path = p.str("table")?;
     let evaluation = match p.str("evaluation")?.unwrap_or(if table_path.is_some() {
         "table"
@@ -54,8 +69,12 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
         "stochastic"
     }) {
         "stochastic" => IlEvaluation::Stochastic,
-        "quadrature" => IlEvaluation::Quadrature {
-            samples: samples.unwrap_or(1024),
+        "quadrature" => match (samples, tolerance) {
+            (Some(_), Some(_)) => return Err(samples_and_tolerance()),
+            (Some(n), None) => IlEvaluation::Quadrature { samples: n },
+            (None, t) => IlEvaluation::Adaptive {
+                tolerance: check_tolerance(t.unwrap_or(DEFAULT_TOLERANCE))?,
+            },
         },
         "table" => {
             let path = table_path.ok_or_else(|| ParamError::MissingKey {
@@ -69,9 +88,18 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
         "approx" => IlEvaluation::Approx,
         other => return Err(choice("evaluation", other, BodyEvaluation::NAMES)),
     };
-    if samples.is_some() && !matches!(evaluation, IlEvaluation::Quadrature { .. }) {
+    let quadrature = matches!(
+        evaluation,
+        IlEvaluation::Quadrature { .. } | IlEvaluation::Adaptive { .. }
+    );
+    if samples.is_some() && !quadrature {
         return Err(ParamError::Invalid(
             "`samples` applies to evaluation = \"quadrature\"".into(),
+        ));
+    }
+    if tolerance.is_some() && !quadrature {
+        return Err(ParamError::Invalid(
+            "`tolerance` applies to evaluation = \"quadrature\"".into(),
         ));
     }
     if table_path.is_some() && !matches!(evaluation, IlEvaluation::Table(_)) {
@@ -95,6 +123,15 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
     Ok(recipe)
 }
 
+/// `samples` (fixed N) and `tolerance` (adaptive) are the two forms of "quadrature".
+pub(super) fn samples_and_tolerance() -> ParamError {
+    ParamError::Invalid(
+        "`samples` (a fixed set of N microfacets) and `tolerance` (adaptive quadrature) \
+         are exclusive forms of evaluation = \"quadrature\": give one"
+            .into(),
+    )
+}
+
 /// The IL model; the approximation's coefficients are looked up here, for the lobe's
 /// current roughness.
 pub(super) fn build_il(
@@ -107,6 +144,9 @@ pub(super) fn build_il(
     let ev = match evaluation {
         IlEvaluation::Stochastic => BodyEvaluation::Stochastic,
         IlEvaluation::Quadrature { samples } => BodyEvaluation::Quadrature { samples: *samples },
+        IlEvaluation::Adaptive { tolerance } => BodyEvaluation::Adaptive {
+            tolerance: *tolerance,
+        },
         IlEvaluation::Table(t) => BodyEvaluation::Table(t.clone()),
         IlEvaluation::Approx => match lobe {
             Some(l) => BodyEvaluation::Approx(Arc::new(IlApprox::new(l, ni)?)),
