@@ -5,7 +5,8 @@ use thiserror::Error;
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ParamError {
-    #[error("parameter `{name}` = {value} is out of range: expected {expected}")]
+    // Values are printed short (1.00000e308, not 309 digits).
+    #[error("parameter `{name}` = {} is out of range: expected {expected}", crate::math::fmt_num(*.value))]
     OutOfRange {
         name: String,
         value: f64,
