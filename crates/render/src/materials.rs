@@ -153,6 +153,12 @@ impl SceneMaterial {
         })
     }
 
+    /// Why this material is far slower to render than expected, if it is (see
+    /// `MaterialRecipe::render_cost_warning`).
+    pub fn render_cost_warning(&self) -> Option<&'static str> {
+        self.recipe.render_cost_warning()
+    }
+
     /// The material's lane model, where it has one (see `facette_bsdf::lanes`).
     #[inline]
     pub fn lane_bsdf(&self) -> Option<&LaneBsdf> {

@@ -271,3 +271,31 @@ fn toml_error_or_ok(text: &str) -> Option<String> {
     let p = write(d.path(), "s.toml", text);
     load_scene(&p).err().map(|e| e.to_string())
 }
+
+#[test]
+fn adaptive_quadrature_in_a_scene_is_warned_about() {
+    let d = tempfile::tempdir().unwrap();
+    let text = TOML_SCENE.replace(
+        "material = { type = \"lambert\", reflectance = 0.5 }",
+        "material = { type = \"il\", ni = 1.5, distribution = \"beckmann\", alpha = 0.3, evaluation = \"quadrature\" }",
+    );
+    let scene = load_scene(&write(d.path(), "s.toml", &text)).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("samples = N"),
+        "{:?}",
+        scene.warnings
+    );
+    // The fixed set and the stochastic estimate are what renders use: no warning.
+    for ev in [
+        "evaluation = \"quadrature\", samples = 64",
+        "evaluation = \"stochastic\"",
+    ] {
+        let text = TOML_SCENE.replace(
+            "material = { type = \"lambert\", reflectance = 0.5 }",
+            &format!("material = {{ type = \"il\", ni = 1.5, distribution = \"beckmann\", alpha = 0.3, {ev} }}"),
+        );
+        let scene = load_scene(&write(d.path(), "s.toml", &text)).unwrap();
+        assert!(scene.warnings.is_empty(), "{ev}: {:?}", scene.warnings);
+    }
+}

@@ -276,6 +276,28 @@ impl MaterialRecipe {
         }
     }
 
+    /// Why evaluating this material costs far more than a path tracer expects, if it does:
+    /// adaptive quadrature (IL or exact Oren–Nayar `evaluation = "quadrature"` without
+    /// `samples`) integrates to its tolerance at every evaluation, about 2 ms each. The
+    /// renderer warns about it; the lab wants exactly that.
+    pub fn render_cost_warning(&self) -> Option<&'static str> {
+        let adaptive = match self {
+            MaterialRecipe::Il { evaluation, .. } => {
+                matches!(evaluation, IlEvaluation::Adaptive { .. })
+            }
+            MaterialRecipe::OrenNayar { evaluation, .. } => matches!(
+                evaluation,
+                crate::models::oren_nayar::IntegralEvaluation::Adaptive { .. }
+            ),
+            _ => false,
+        };
+        adaptive.then_some(
+            "evaluation = \"quadrature\" integrates adaptively to its tolerance at every \
+             shading point (about 2 ms each): renders want evaluation = \"stochastic\" or \
+             a fixed set, samples = N",
+        )
+    }
+
     /// True when the BSDF depends on the shading point's footprint (glints): the renderer
     /// must build it per hit with [`MaterialRecipe::build_at`].
     pub fn varies_per_hit(&self) -> bool {

@@ -57,6 +57,14 @@ pub(crate) fn build_scene(
     let geometry = SceneGeometry::new(objects.shapes).map_err(|x| ctx.err(None, x.to_string()))?;
     let lights = lights::create_lights(&ctx, &objects.shape_emission, &desc.lights)?;
     let selector = lights::create_selector(&lights.lights, &geometry);
+    let warnings = materials
+        .list
+        .iter()
+        .filter_map(|m| {
+            let w = m.render_cost_warning()?;
+            Some(format!("material `{}`: {w}", m.name))
+        })
+        .collect();
     Ok(Scene {
         geometry,
         shape_material: objects.shape_material,
@@ -69,6 +77,6 @@ pub(crate) fn build_scene(
         film,
         integrator,
         source_hash,
-        warnings: Vec::new(),
+        warnings,
     })
 }

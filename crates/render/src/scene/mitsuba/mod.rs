@@ -146,6 +146,7 @@ pub fn load_mitsuba_scene(path: &Path, defines: &[(String, String)]) -> Result<S
     let mut built = build_scene(spans, main_dir, desc, fnv1a(hashed.as_bytes()))?;
     let mut warnings = std::mem::take(&mut cx.warnings);
     clip.check(&built, &mut warnings);
+    warnings.append(&mut built.warnings);
     built.warnings = warnings;
     Ok(built)
 }
