@@ -11,7 +11,7 @@
 //! Every write is atomic (temporary file, fsync, rename; see `facette_bsdf::storage::atomic_file`).
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, ErrorKind, Read};
+use std::io::{BufReader, BufWriter, ErrorKind, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use image::{DynamicImage, ImageFormat, ImageReader};
@@ -158,7 +158,10 @@ fn decode_with_image_crate(path: &Path, format: FileFormat) -> Result<DynamicIma
             .map_err(too_large)?;
         limits.max_alloc = Some(limits.max_alloc.unwrap_or(0).max(pixels.saturating_mul(16)));
     }
-    let file = File::open(path).map_err(|e| read_failure(path, e))?;
+    // The same file, rewound after the header probe.
+    let mut file = file;
+    file.seek(SeekFrom::Start(0))
+        .map_err(|e| read_failure(path, e))?;
     let mut reader = ImageReader::with_format(BufReader::new(file), image_format);
     reader.limits(limits);
     // A decoder panic on malformed input must not take a render down with it.

@@ -22,6 +22,26 @@ use std::path::Path;
 pub use obj::read_obj;
 pub use ply::read_ply;
 
+/// The bytes of a mesh file, its size checked against `limits::MESH_FILE_BYTES` before it
+/// is read into memory; `format` names it in the error.
+fn read_mesh_bytes(path: &Path, format: &'static str) -> GeometryResult<Vec<u8>> {
+    if let Ok(m) = std::fs::metadata(path) {
+        facette_bsdf::limits::MESH_FILE_BYTES
+            .check(m.len())
+            .map_err(|e| {
+                GeometryError::Malformed {
+                    format,
+                    message: e.to_string(),
+                }
+                .in_file(path, None)
+            })?;
+    }
+    std::fs::read(path).map_err(|source| GeometryError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
 /// Reads an `.obj` or `.ply` file (by extension, case-insensitive) with Mitsuba's
 /// defaults (OBJ texture coordinates flipped).
 pub fn read_mesh(path: &Path) -> GeometryResult<MeshData> {

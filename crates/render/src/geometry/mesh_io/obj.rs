@@ -16,20 +16,7 @@ use std::path::Path;
 
 /// Reads an OBJ file. `flip_tex_coords` maps `v ↦ 1 − v` (Mitsuba's default).
 pub fn read_obj(path: &Path, flip_tex_coords: bool) -> GeometryResult<MeshData> {
-    // The size is checked before the file is read into memory.
-    if let Ok(m) = std::fs::metadata(path) {
-        limits::MESH_FILE_BYTES.check(m.len()).map_err(|e| {
-            GeometryError::Malformed {
-                format: "OBJ",
-                message: e.to_string(),
-            }
-            .in_file(path, None)
-        })?;
-    }
-    let bytes = std::fs::read(path).map_err(|source| GeometryError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = super::read_mesh_bytes(path, "OBJ")?;
     parse_obj(&bytes, flip_tex_coords).map_err(|(e, line)| e.in_file(path, line))
 }
 

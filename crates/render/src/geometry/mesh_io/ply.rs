@@ -29,20 +29,7 @@ use std::path::Path;
 
 /// Reads a PLY file.
 pub fn read_ply(path: &Path) -> GeometryResult<MeshData> {
-    // The size is checked before the file is read into memory.
-    if let Ok(m) = std::fs::metadata(path) {
-        limits::MESH_FILE_BYTES.check(m.len()).map_err(|e| {
-            GeometryError::Malformed {
-                format: "PLY",
-                message: e.to_string(),
-            }
-            .in_file(path, None)
-        })?;
-    }
-    let bytes = std::fs::read(path).map_err(|source| GeometryError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = super::read_mesh_bytes(path, "PLY")?;
     parse_ply(&bytes).map_err(|(e, line)| e.in_file(path, line))
 }
 
