@@ -6,6 +6,7 @@
 //! Cephes polynomials (Moshier, *Cephes Math Library*, `sinf`/`cosf`/`expf`/`logf`),
 //! about 1 ulp on the ranges the models use, so that they vectorize too.
 
+use super::array_lanes::{array_lanes, lanewise};
 use super::real::{Mask, Real};
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
@@ -24,126 +25,11 @@ pub struct M32x8(pub [u32; 8]);
 #[repr(C, align(32))]
 struct I32x8([i32; 8]);
 
-macro_rules! lanewise {
-    ($a:expr, |$x:ident| $e:expr) => {{
-        let a = $a;
-        let mut r = [Default::default(); 8];
-        for i in 0..8 {
-            let $x = a[i];
-            r[i] = $e;
-        }
-        r
-    }};
-    ($a:expr, $b:expr, |$x:ident, $y:ident| $e:expr) => {{
-        let (a, b) = ($a, $b);
-        let mut r = [Default::default(); 8];
-        for i in 0..8 {
-            let ($x, $y) = (a[i], b[i]);
-            r[i] = $e;
-        }
-        r
-    }};
-}
-
-macro_rules! binop {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for F32x8 {
-            type Output = F32x8;
-            #[inline(always)]
-            fn $f(self, o: F32x8) -> F32x8 {
-                F32x8(lanewise!(self.0, o.0, |a, b| a $op b))
-            }
-        }
-    };
-}
-binop!(Add, add, +);
-binop!(Sub, sub, -);
-binop!(Mul, mul, *);
-binop!(Div, div, /);
-
-impl Neg for F32x8 {
-    type Output = F32x8;
-    #[inline(always)]
-    fn neg(self) -> F32x8 {
-        F32x8(lanewise!(self.0, |a| -a))
-    }
-}
-
-impl BitAnd for M32x8 {
-    type Output = M32x8;
-    #[inline(always)]
-    fn bitand(self, o: M32x8) -> M32x8 {
-        M32x8(lanewise!(self.0, o.0, |a, b| a & b))
-    }
-}
-impl BitOr for M32x8 {
-    type Output = M32x8;
-    #[inline(always)]
-    fn bitor(self, o: M32x8) -> M32x8 {
-        M32x8(lanewise!(self.0, o.0, |a, b| a | b))
-    }
-}
-impl Not for M32x8 {
-    type Output = M32x8;
-    #[inline(always)]
-    fn not(self) -> M32x8 {
-        M32x8(lanewise!(self.0, |a| !a))
-    }
-}
-
-impl M32x8 {
-    /// One bit per lane, lane 0 in bit 0 (AVX's `movemask`).
-    #[inline(always)]
-    pub fn bits(self) -> u32 {
-        let mut b = 0;
-        for i in 0..8 {
-            b |= (self.0[i] >> 31) << i;
-        }
-        b
-    }
-}
-
-impl Mask for M32x8 {
-    #[inline(always)]
-    fn splat(b: bool) -> Self {
-        M32x8([if b { !0 } else { 0 }; 8])
-    }
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.bits() != 0
-    }
-    #[inline(always)]
-    fn all(self) -> bool {
-        self.bits() == 0xFF
-    }
-    #[inline(always)]
-    fn lane(self, i: usize) -> bool {
-        self.0[i] != 0
-    }
-    #[inline(always)]
-    fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
-        M32x8(std::array::from_fn(|i| if f(i) { !0 } else { 0 }))
-    }
-}
-
-#[inline(always)]
-fn cmp(a: F32x8, b: F32x8, f: impl Fn(f32, f32) -> bool) -> M32x8 {
-    M32x8(lanewise!(a.0, b.0, |x, y| if f(x, y) { !0u32 } else { 0 }))
-}
-
 /// 1.5 · 2²³: adding it rounds an f32 below 2²² to the nearest integer, which its low
 /// mantissa bits then hold (the branch-free rounding of vectorized libms).
 const ROUND_MAGIC: f32 = 12_582_912.0;
 
 impl F32x8 {
-    #[inline(always)]
-    fn bits(self) -> [u32; 8] {
-        lanewise!(self.0, |a| a.to_bits())
-    }
-    #[inline(always)]
-    fn from_bits(b: [u32; 8]) -> F32x8 {
-        F32x8(lanewise!(b, |a| f32::from_bits(a)))
-    }
     /// (round(x) as f32, round(x) as i32) for |x| < 2²².
     #[inline(always)]
     fn round_with_int(self) -> (F32x8, I32x8) {
@@ -155,70 +41,7 @@ impl F32x8 {
     }
 }
 
-impl Real for F32x8 {
-    type Mask = M32x8;
-    const LANES: usize = 8;
-    const TINY: f64 = 1e-30;
-
-    #[inline(always)]
-    fn splat(v: f64) -> Self {
-        F32x8([v as f32; 8])
-    }
-    #[inline(always)]
-    fn lane(self, i: usize) -> f64 {
-        self.0[i] as f64
-    }
-    #[inline(always)]
-    fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
-        F32x8(std::array::from_fn(|i| f(i) as f32))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        F32x8(lanewise!(self.0, |a| a.sqrt()))
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        Self::from_bits(lanewise!(self.bits(), |b| b & 0x7FFF_FFFF))
-    }
-    /// `self < o ? self : o` (the SSE/AVX `min` operand order: a NaN `self` yields `o`).
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        F32x8(lanewise!(self.0, o.0, |a, b| if a < b { a } else { b }))
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        F32x8(lanewise!(self.0, o.0, |a, b| if a > b { a } else { b }))
-    }
-    #[inline(always)]
-    fn lt(self, o: Self) -> M32x8 {
-        cmp(self, o, |a, b| a < b)
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> M32x8 {
-        cmp(self, o, |a, b| a <= b)
-    }
-    #[inline(always)]
-    fn gt(self, o: Self) -> M32x8 {
-        cmp(self, o, |a, b| a > b)
-    }
-    #[inline(always)]
-    fn ge(self, o: Self) -> M32x8 {
-        cmp(self, o, |a, b| a >= b)
-    }
-    #[inline(always)]
-    fn eq(self, o: Self) -> M32x8 {
-        cmp(self, o, |a, b| a == b)
-    }
-    #[inline(always)]
-    fn select(m: M32x8, a: Self, b: Self) -> Self {
-        let (ab, bb) = (a.bits(), b.bits());
-        let mut r = [0u32; 8];
-        for i in 0..8 {
-            r[i] = (m.0[i] & ab[i]) | (!m.0[i] & bb[i]);
-        }
-        Self::from_bits(r)
-    }
-
+array_lanes!(F32x8, M32x8, f32, u32, 8, tiny = 1e-30, {
     /// Cephes `sinf`/`cosf`: the quadrant k = round(x·2/π), the remainder
     /// z = |x| − kπ/2 in three parts, and the two minimax polynomials on [−π/4, π/4].
     /// Accurate to about 1 ulp for |x| < 2¹³ (the models pass angles in [0, 2π]).
@@ -316,19 +139,7 @@ impl Real for F32x8 {
         let out = Self::select(self.eq(F32x8::zero()), -inf, out);
         Self::select(self.ge(F32x8::zero()), out, F32x8::splat(f64::NAN))
     }
-
-    #[inline(always)]
-    fn is_finite(self) -> M32x8 {
-        M32x8(lanewise!(
-            self.bits(),
-            |b| if b & 0x7F80_0000 != 0x7F80_0000 {
-                !0u32
-            } else {
-                0
-            }
-        ))
-    }
-}
+});
 
 #[cfg(test)]
 mod tests {

@@ -1,14 +1,17 @@
 //! One source, several widths: the [`Real`] lane trait and its instantiations (`f64` for the
-//! lab, `f32` and [`F32x8`] for the renderer's kernel) and the lane vector [`LVec3`] — the
-//! bottom layer of the lane code, beside `math`. The models that vectorize are
-//! `models::lane_models`, over these lanes. The microfacet core
+//! lab, `f32` and [`F32x8`] for the renderer's kernel, [`F64x4`] for its geometry) and the
+//! lane vector [`LVec3`] — the bottom layer of the lane code, beside `math`. The models that
+//! vectorize are `models::lane_models`, over these lanes. The microfacet core
 //! (`microfacet::{Ggx, Beckmann}`'s `*_lanes` methods, `fresnel::*_lanes`) is the source
 //! the f64 [`Distribution`](crate::microfacet::Distribution) methods instantiate.
 
+pub(crate) mod array_lanes;
 mod f32x8;
+mod f64x4;
 mod real;
 mod vec3;
 
 pub use f32x8::{F32x8, M32x8};
+pub use f64x4::{F64x4, M64x4};
 pub use real::{Mask, Real};
 pub use vec3::LVec3;

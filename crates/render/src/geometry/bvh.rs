@@ -79,6 +79,10 @@
 //! unchanged within noise (the collapse is a sequential pass over the binary nodes). The
 //! images rendered are bit-identical. Figures: docs/performance.md.
 
+mod packet;
+
+pub use packet::{lanes_of, Lanes, PacketBox, PACKET};
+
 use super::bounds::Bounds3;
 use super::ray::Ray;
 use super::Vec3;
@@ -438,21 +442,22 @@ impl RayBox {
         for a in 0..3 {
             // scale / ±0 = ±∞ keeps the sign of a zero component; otherwise |inv| ≥ 1.
             let inv = scale / d[a];
-            let o = ray.origin[a];
             rb.inv[a] = inv as f32;
-            if inv < 0.0 {
-                rb.near[a] = HI + a;
-                rb.far[a] = a;
-                rb.org_near[a] = f32_down(o);
-                rb.org_far[a] = f32_up(o);
-            } else {
-                rb.near[a] = a;
-                rb.far[a] = HI + a;
-                rb.org_near[a] = f32_up(o);
-                rb.org_far[a] = f32_down(o);
-            }
+            (rb.near[a], rb.far[a]) = if inv < 0.0 { (HI + a, a) } else { (a, HI + a) };
+            (rb.org_near[a], rb.org_far[a]) = Self::rounded_origin(ray.origin[a], inv);
         }
         rb
+    }
+
+    /// The origin coordinate `o` rounded to f32 for the near plane and for the far plane
+    /// of an axis with inverse direction `inv`: the rounding that only widens the slab.
+    #[inline]
+    fn rounded_origin(o: f64, inv: f64) -> (f32, f32) {
+        if inv < 0.0 {
+            (f32_down(o), f32_up(o))
+        } else {
+            (f32_up(o), f32_down(o))
+        }
     }
 
     /// The box-test distance limit for ray distance `t_max`, rounded up.

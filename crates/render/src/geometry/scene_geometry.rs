@@ -11,6 +11,8 @@ use super::triangle::TriangleRay;
 use super::{Vec2, Vec3};
 use rayon::prelude::*;
 
+mod packet;
+
 /// One BVH primitive: a triangle of a mesh or a whole analytic shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct PrimRef {
@@ -170,8 +172,14 @@ impl SceneGeometry {
             self.test_prim(slot, ray, &mut tri, t_max)
                 .map(|h| (h.t, (slot, h)))
         })?;
+        Some(self.hit_record(slot, ray, hit, detail))
+    }
+
+    /// The surface details of `ray`'s hit `hit` on the primitive in `slot`.
+    #[inline]
+    fn hit_record(&self, slot: usize, ray: &Ray, hit: PrimHit, detail: HitDetail) -> SurfaceHit {
         let r = self.prims[slot];
-        Some(match &self.shapes[r.shape as usize] {
+        match &self.shapes[r.shape as usize] {
             Shape::Mesh(m) => m.surface_hit(ray, r.prim as usize, hit, r.shape),
             Shape::Sphere(s) => match detail {
                 HitDetail::Full => s.surface_hit(ray, hit, r.shape),
@@ -179,7 +187,7 @@ impl SceneGeometry {
             },
             Shape::Rectangle(q) => q.surface_hit(ray, hit, r.shape),
             Shape::Disk(d) => d.surface_hit(ray, hit, r.shape),
-        })
+        }
     }
 
     /// Fills in the details [`HitDetail::Shading`] left out, as [`HitDetail::Full`]

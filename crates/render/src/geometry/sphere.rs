@@ -30,6 +30,7 @@ use super::ray::Ray;
 use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
+use facette_bsdf::lanes::{LVec3, Real};
 use facette_bsdf::math::warp::square_to_uniform_sphere;
 use facette_bsdf::math::Frame;
 use std::f64::consts::{PI, TAU};
@@ -124,41 +125,40 @@ impl Sphere {
     /// discriminant from the distance between the centre and the ray's closest point
     /// (no cancellation for distant origins) and the stable root pair `q`, `c/q`.
     pub fn intersect_prim(&self, ray: &Ray) -> Option<PrimHit> {
-        let o = ray.origin - self.center;
-        let d = ray.dir;
-        let a = d.length_squared();
-        if !(a > 0.0) {
-            return None;
-        }
-        let half_b = o.dot(d);
-        let c = o.length_squared() - self.radius * self.radius;
-        let closest = (o - (half_b / a) * d).length();
-        let disc = a * (self.radius + closest) * (self.radius - closest);
-        if !(disc >= 0.0) {
-            return None;
-        }
-        let root = disc.sqrt();
-        let q = if half_b > 0.0 {
-            -(half_b + root)
-        } else {
-            -(half_b - root)
-        };
-        if q == 0.0 {
-            // Origin on the sphere, ray tangent: both roots are 0.
-            return None;
-        }
-        let (mut t0, mut t1) = (q / a, c / q);
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
-        if !(t0 <= ray.t_max && t1 > 0.0) {
-            return None;
-        }
-        let t = if t0 > 0.0 { t0 } else { t1 };
-        (t <= ray.t_max).then_some(PrimHit {
+        let (hit, t) = self.intersect_lanes::<f64>(ray.origin.into(), ray.dir.into(), ray.t_max);
+        hit.then_some(PrimHit {
             t,
             local: Vec2::ZERO,
         })
+    }
+
+    /// [`intersect_prim`](Self::intersect_prim) for a lane of rays (origins `o`,
+    /// directions `d`, limits `t_max`): whether each lane hits in `(0, t_max]`, and where.
+    /// The one source of the sphere test: `f64` for one ray, `F64x4` for the packet
+    /// kernel's rays four at a time, bit for bit the same. It is pbrt-v4's robust
+    /// quadratic: the discriminant from the distance of the ray's closest approach
+    /// (Haines et al., *Ray Tracing Gems* ch. 7), both roots without cancellation.
+    #[inline(always)]
+    pub fn intersect_lanes<R: Real>(&self, o: LVec3<R>, d: LVec3<R>, t_max: R) -> (R::Mask, R) {
+        let zero = R::zero();
+        let o = o - LVec3::splat(self.center);
+        let a = d.length_squared();
+        let half_b = o.dot(d);
+        let r = R::splat(self.radius);
+        let c = o.length_squared() - r * r;
+        let closest = (o - d.scale(half_b / a)).length_squared().sqrt();
+        let disc = a * (r + closest) * (r - closest);
+        let root = disc.sqrt();
+        let q = R::select(half_b.gt(zero), -(half_b + root), -(half_b - root));
+        let (r0, r1) = (q / a, c / q);
+        let (t0, t1) = (r0.min(r1), R::select(r0.gt(r1), r0, r1));
+        let t = R::select(t0.gt(zero), t0, t1);
+        // `q == 0`: origin on the sphere, ray tangent (both roots 0). The comparisons are
+        // false for NaN lanes (a zero direction, a negative discriminant's root); a NaN
+        // root is refused before `min` could drop it.
+        let ordered = r0.eq(r0) & r1.eq(r1);
+        let hit = a.gt(zero) & disc.ge(zero) & !q.eq(zero) & ordered & t0.le(t_max) & t1.gt(zero);
+        (hit & t.le(t_max), t)
     }
 
     /// The surface details of a hit found by [`intersect_prim`](Self::intersect_prim).

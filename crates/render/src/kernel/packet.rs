@@ -173,10 +173,12 @@ fn step<R: Real>(
     lanes: &mut [Option<Path>; LANES],
     sums: &mut [PixelSums],
 ) {
+    let rays: [Option<Ray>; LANES] = std::array::from_fn(|k| lanes[k].as_ref().map(|p| p.ray));
+    let hits = scene.geometry.intersect_packet(&rays, HitDetail::Shading);
     let mut vertices: [Option<Vertex>; LANES] = Default::default();
-    for (lane, vertex) in lanes.iter_mut().zip(vertices.iter_mut()) {
+    for ((lane, vertex), hit) in lanes.iter_mut().zip(vertices.iter_mut()).zip(hits) {
         let Some(path) = lane else { continue };
-        *vertex = arrive(scene, strategy, path);
+        *vertex = arrive(scene, strategy, path, hit);
         if vertex.is_none() {
             finish(lane, sums);
         }
@@ -191,9 +193,14 @@ fn step<R: Real>(
         }
     }
     eval_materials::<R>(scene, lanes, &vertices, &mut lights);
+    let shadows: [Option<Ray>; LANES] = std::array::from_fn(|k| match &lights[k] {
+        Some(c) if lanes[k].is_some() && !c.f.is_black() => Some(c.ls.shadow),
+        _ => None,
+    });
+    let occluded = scene.geometry.occluded_packet(&shadows);
     for k in 0..LANES {
-        if let (Some(path), Some(c)) = (&mut lanes[k], &lights[k]) {
-            if !c.f.is_black() && !scene.geometry.occluded_ray(&c.ls.shadow) {
+        if let (Some(path), Some(c), Some(_)) = (&mut lanes[k], &lights[k], &shadows[k]) {
+            if occluded & (1 << k) == 0 {
                 let pl = c.p_select * c.ls.pdf;
                 let w = if c.ls.delta || strategy == Strategy::NeeOnly {
                     1.0
@@ -216,10 +223,15 @@ fn step<R: Real>(
     }
 }
 
-/// Intersects the lane's ray and adds what it sees emitted; the vertex to shade, or `None`
-/// where the path ends.
+/// Adds what the lane's ray sees emitted at its hit `hit` (or in the environment where it
+/// has none); the vertex to shade, or `None` where the path ends.
 #[inline]
-fn arrive<'s>(scene: &'s Scene, strategy: Strategy, path: &mut Path) -> Option<Vertex<'s>> {
+fn arrive<'s>(
+    scene: &'s Scene,
+    strategy: Strategy,
+    path: &mut Path,
+    hit: Option<SurfaceHit>,
+) -> Option<Vertex<'s>> {
     let ray = path.ray;
     let mis = |path: &Path, pl: f64| match strategy {
         _ if path.delta_prev => 1.0,
@@ -227,7 +239,7 @@ fn arrive<'s>(scene: &'s Scene, strategy: Strategy, path: &mut Path) -> Option<V
         Strategy::NeeOnly => 0.0,
         Strategy::BsdfOnly => 1.0,
     };
-    let Some(mut hit) = scene.geometry.intersect_with(&ray, HitDetail::Shading) else {
+    let Some(mut hit) = hit else {
         if let Some(env) = scene.environment {
             if let Light::Environment(e) = &scene.lights[env as usize] {
                 let pl = scene.selector.probability(env as usize) * e.pdf(ray.dir);

@@ -1,0 +1,209 @@
+//! What every array-backed lane type shares: the arithmetic, comparisons, masks and
+//! `select` written as plain loops over `[T; N]` (each loop one vector instruction where
+//! the function is compiled for the target's vector width), generated once by
+//! [`array_lanes!`] for [`F32x8`](super::F32x8) and [`F64x4`](super::F64x4). Each type adds
+//! its own transcendental functions.
+
+/// `[f(a[0]), …, f(a[N−1])]`: the length comes from the input array.
+#[inline(always)]
+pub(crate) fn map1<T: Copy, U, const N: usize>(a: [T; N], f: impl Fn(T) -> U) -> [U; N] {
+    std::array::from_fn(|i| f(a[i]))
+}
+
+/// `[f(a[0], b[0]), …]`.
+#[inline(always)]
+pub(crate) fn map2<T: Copy, S: Copy, U, const N: usize>(
+    a: [T; N],
+    b: [S; N],
+    f: impl Fn(T, S) -> U,
+) -> [U; N] {
+    std::array::from_fn(|i| f(a[i], b[i]))
+}
+
+/// `lanewise!(a, |x| e)` is [`map1`], `lanewise!(a, b, |x, y| e)` is [`map2`].
+macro_rules! lanewise {
+    ($a:expr, |$x:ident| $e:expr) => {
+        $crate::lanes::array_lanes::map1($a, |$x| $e)
+    };
+    ($a:expr, $b:expr, |$x:ident, $y:ident| $e:expr) => {
+        $crate::lanes::array_lanes::map2($a, $b, |$x, $y| $e)
+    };
+}
+pub(crate) use lanewise;
+
+/// The operators, the mask type's [`Mask`](super::Mask) impl and a [`Real`](super::Real)
+/// impl for the lane type `$real` (`[$elem; $n]`) and its mask `$mask` (`[$bits; $n]`, all
+/// bits set or clear per lane, the layout of a vector compare), with the transcendental
+/// methods (`sin_cos`, `exp`, `ln`) given as `$special`.
+macro_rules! array_lanes {
+    ($real:ident, $mask:ident, $elem:ty, $bits:ty, $n:literal, tiny = $tiny:expr, { $($special:tt)* }) => {
+        macro_rules! binop {
+            ($tr:ident, $f:ident, $op:tt) => {
+                impl $tr for $real {
+                    type Output = $real;
+                    #[inline(always)]
+                    fn $f(self, o: $real) -> $real {
+                        $real(lanewise!(self.0, o.0, |a, b| a $op b))
+                    }
+                }
+            };
+        }
+        binop!(Add, add, +);
+        binop!(Sub, sub, -);
+        binop!(Mul, mul, *);
+        binop!(Div, div, /);
+
+        impl Neg for $real {
+            type Output = $real;
+            #[inline(always)]
+            fn neg(self) -> $real {
+                $real(lanewise!(self.0, |a| -a))
+            }
+        }
+
+        impl BitAnd for $mask {
+            type Output = $mask;
+            #[inline(always)]
+            fn bitand(self, o: $mask) -> $mask {
+                $mask(lanewise!(self.0, o.0, |a, b| a & b))
+            }
+        }
+        impl BitOr for $mask {
+            type Output = $mask;
+            #[inline(always)]
+            fn bitor(self, o: $mask) -> $mask {
+                $mask(lanewise!(self.0, o.0, |a, b| a | b))
+            }
+        }
+        impl Not for $mask {
+            type Output = $mask;
+            #[inline(always)]
+            fn not(self) -> $mask {
+                $mask(lanewise!(self.0, |a| !a))
+            }
+        }
+
+        impl $mask {
+            /// One bit per lane, lane 0 in bit 0 (AVX's `movemask`).
+            #[inline(always)]
+            pub fn bits(self) -> u32 {
+                let mut b = 0;
+                for i in 0..$n {
+                    b |= ((self.0[i] >> (<$bits>::BITS - 1)) as u32) << i;
+                }
+                b
+            }
+        }
+
+        impl Mask for $mask {
+            #[inline(always)]
+            fn splat(b: bool) -> Self {
+                $mask([if b { !0 } else { 0 }; $n])
+            }
+            #[inline(always)]
+            fn any(self) -> bool {
+                self.bits() != 0
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                self.bits() == (1 << $n) - 1
+            }
+            #[inline(always)]
+            fn lane(self, i: usize) -> bool {
+                self.0[i] != 0
+            }
+            #[inline(always)]
+            fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
+                $mask(std::array::from_fn(|i| if f(i) { !0 } else { 0 }))
+            }
+        }
+
+        impl $real {
+            #[inline(always)]
+            fn cmp(self, b: $real, f: impl Fn($elem, $elem) -> bool) -> $mask {
+                $mask(lanewise!(self.0, b.0, |x, y| if f(x, y) { !0 } else { 0 }))
+            }
+            #[inline(always)]
+            fn bits(self) -> [$bits; $n] {
+                lanewise!(self.0, |a| a.to_bits())
+            }
+            #[inline(always)]
+            fn from_bits(b: [$bits; $n]) -> $real {
+                $real(lanewise!(b, |a| <$elem>::from_bits(a)))
+            }
+        }
+
+        impl Real for $real {
+            type Mask = $mask;
+            const LANES: usize = $n;
+            const TINY: f64 = $tiny;
+
+            #[inline(always)]
+            fn splat(v: f64) -> Self {
+                $real([v as $elem; $n])
+            }
+            #[inline(always)]
+            fn lane(self, i: usize) -> f64 {
+                self.0[i] as f64
+            }
+            #[inline(always)]
+            fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+                $real(std::array::from_fn(|i| f(i) as $elem))
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $real(lanewise!(self.0, |a| a.sqrt()))
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                Self::from_bits(lanewise!(self.bits(), |b| b & (<$bits>::MAX >> 1)))
+            }
+            /// `self < o ? self : o` (the SSE/AVX `min` operand order: a NaN `self` yields
+            /// `o`).
+            #[inline(always)]
+            fn min(self, o: Self) -> Self {
+                $real(lanewise!(self.0, o.0, |a, b| if a < b { a } else { b }))
+            }
+            #[inline(always)]
+            fn max(self, o: Self) -> Self {
+                $real(lanewise!(self.0, o.0, |a, b| if a > b { a } else { b }))
+            }
+            #[inline(always)]
+            fn lt(self, o: Self) -> $mask {
+                self.cmp(o, |a, b| a < b)
+            }
+            #[inline(always)]
+            fn le(self, o: Self) -> $mask {
+                self.cmp(o, |a, b| a <= b)
+            }
+            #[inline(always)]
+            fn gt(self, o: Self) -> $mask {
+                self.cmp(o, |a, b| a > b)
+            }
+            #[inline(always)]
+            fn ge(self, o: Self) -> $mask {
+                self.cmp(o, |a, b| a >= b)
+            }
+            #[inline(always)]
+            fn eq(self, o: Self) -> $mask {
+                self.cmp(o, |a, b| a == b)
+            }
+            #[inline(always)]
+            fn select(m: $mask, a: Self, b: Self) -> Self {
+                let (ab, bb) = (a.bits(), b.bits());
+                let mut r = [0; $n];
+                for i in 0..$n {
+                    r[i] = (m.0[i] & ab[i]) | (!m.0[i] & bb[i]);
+                }
+                Self::from_bits(r)
+            }
+            #[inline(always)]
+            fn is_finite(self) -> $mask {
+                self.cmp(self, |a, _| a.is_finite())
+            }
+
+            $($special)*
+        }
+    };
+}
+pub(crate) use array_lanes;

@@ -1,0 +1,254 @@
+//! Ray queries for a packet of eight rays ([`Bvh::closest_hit_packet`],
+//! [`Bvh::any_hit_packet`]): spheres are tested four lanes at a time by their one-source
+//! test ([`Sphere::intersect_lanes`] with `F64x4`: the same bits as one ray at a time),
+//! triangles, rectangles and disks lane by lane with their one-ray tests. A lane's hit is
+//! therefore the hit the one-ray query finds; only among primitives hit at exactly the
+//! same distance may the two orders pick different ones.
+
+use super::{is_valid_query, HitDetail, SceneGeometry};
+use crate::geometry::bvh::{lanes_of, Lanes, PacketBox, PACKET};
+use crate::geometry::interaction::{PrimHit, SurfaceHit};
+use crate::geometry::ray::Ray;
+use crate::geometry::shape::Shape;
+use crate::geometry::sphere::Sphere;
+use crate::geometry::triangle::TriangleRay;
+use crate::geometry::{Vec2, Vec3};
+use facette_bsdf::lanes::{F64x4, LVec3};
+
+/// The packet's rays as two groups of four f64 lanes.
+struct LaneRays {
+    o: [LVec3<F64x4>; 2],
+    d: [LVec3<F64x4>; 2],
+}
+
+impl LaneRays {
+    #[inline]
+    fn new(rays: &[Option<Ray>; PACKET]) -> LaneRays {
+        let get = |i: usize, f: fn(&Ray) -> Vec3| rays[i].as_ref().map_or(Vec3::ZERO, f);
+        let group = |h: usize, f: fn(&Ray) -> Vec3| LVec3::from_fn(|j| get(4 * h + j, f));
+        LaneRays {
+            o: [group(0, |r| r.origin), group(1, |r| r.origin)],
+            d: [group(0, |r| r.dir), group(1, |r| r.dir)],
+        }
+    }
+
+    /// The lanes of `lanes` whose ray hits `sphere` in `(0, t_max[i]]`, with the distance.
+    #[inline]
+    fn sphere(
+        &self,
+        sphere: &Sphere,
+        lanes: Lanes,
+        t_max: &[f64; PACKET],
+    ) -> (Lanes, [f64; PACKET]) {
+        let mut hit = 0;
+        let mut t = [0.0; PACKET];
+        for h in 0..2 {
+            if (lanes >> (4 * h)) & 0xF == 0 {
+                continue;
+            }
+            let limit = F64x4(std::array::from_fn(|j| t_max[4 * h + j]));
+            let (m, th) = sphere.intersect_lanes(self.o[h], self.d[h], limit);
+            hit |= (m.bits() as Lanes) << (4 * h);
+            t[4 * h..4 * h + 4].copy_from_slice(&th.0);
+        }
+        (hit & lanes, t)
+    }
+}
+
+/// The lanes whose ray can be queried.
+#[inline]
+fn valid_lanes(rays: &[Option<Ray>; PACKET]) -> Lanes {
+    (0..PACKET).fold(0, |set, i| {
+        set | ((matches!(&rays[i], Some(r) if is_valid_query(r)) as Lanes) << i)
+    })
+}
+
+impl SceneGeometry {
+    /// [`intersect_with`](Self::intersect_with) for every ray of a packet (`None` lanes
+    /// hit nothing).
+    pub fn intersect_packet(
+        &self,
+        rays: &[Option<Ray>; PACKET],
+        detail: HitDetail,
+    ) -> [Option<SurfaceHit>; PACKET] {
+        let lanes = valid_lanes(rays);
+        let mut best: [Option<(usize, PrimHit)>; PACKET] = [None; PACKET];
+        if lanes != 0 {
+            let pb = PacketBox::new(rays, lanes);
+            let lane_rays = LaneRays::new(rays);
+            let mut t_max: [f64; PACKET] =
+                std::array::from_fn(|i| rays[i].map_or(0.0, |r| r.t_max));
+            let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
+            self.bvh
+                .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
+                    let mut found = 0;
+                    if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
+                        let (hit, t) = lane_rays.sphere(s, lanes, t_max);
+                        for i in lanes_of(hit) {
+                            t_max[i] = t[i];
+                            best[i] = Some((
+                                slot,
+                                PrimHit {
+                                    t: t[i],
+                                    local: Vec2::ZERO,
+                                },
+                            ));
+                        }
+                        return hit;
+                    }
+                    for i in lanes_of(lanes) {
+                        let Some(ray) = &rays[i] else { continue };
+                        if let Some(h) = self.test_prim(slot, ray, &mut tri[i], t_max[i]) {
+                            if h.t <= t_max[i] {
+                                t_max[i] = h.t;
+                                best[i] = Some((slot, h));
+                                found |= 1 << i;
+                            }
+                        }
+                    }
+                    found
+                });
+        }
+        std::array::from_fn(|i| {
+            let (slot, hit) = best[i]?;
+            Some(self.hit_record(slot, rays[i].as_ref()?, hit, detail))
+        })
+    }
+
+    /// [`occluded_ray`](Self::occluded_ray) for every ray of a packet: the occluded lanes
+    /// (`None` lanes are not).
+    pub fn occluded_packet(&self, rays: &[Option<Ray>; PACKET]) -> Lanes {
+        let lanes = valid_lanes(rays);
+        if lanes == 0 {
+            return 0;
+        }
+        let pb = PacketBox::new(rays, lanes);
+        let lane_rays = LaneRays::new(rays);
+        let t_max: [f64; PACKET] = std::array::from_fn(|i| rays[i].map_or(0.0, |r| r.t_max));
+        let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
+        self.bvh.any_hit_packet(&pb, lanes, &t_max, |slot, lanes| {
+            if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
+                return lane_rays.sphere(s, lanes, &t_max).0;
+            }
+            lanes_of(lanes).fold(0, |hit, i| {
+                let occluded = rays[i]
+                    .as_ref()
+                    .is_some_and(|ray| self.test_prim(slot, ray, &mut tri[i], t_max[i]).is_some());
+                hit | ((occluded as Lanes) << i)
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::generate::TorusKnot;
+    use crate::geometry::{Disk, Rectangle, Transform};
+    use facette_bsdf::math::rng::{Pcg32, RandomSource};
+    use facette_bsdf::math::warp::square_to_uniform_sphere;
+
+    /// Every kind of primitive: a floor, two spheres (one inside the other's box), a disk
+    /// lamp, and a 2,000-triangle torus knot (a BVH of many nodes).
+    fn scene() -> SceneGeometry {
+        let floor = Rectangle::new(
+            &Transform::scale(Vec3::new(10.0, 10.0, 1.0)).unwrap(),
+            false,
+        )
+        .unwrap();
+        let ball = Sphere::new(Vec3::new(0.0, 0.0, 1.0), 1.0).unwrap();
+        let far_ball = Sphere::new(Vec3::new(1e4, -2e4, 3.0), 2.5).unwrap();
+        let lamp = Disk::new(
+            &(Transform::translate(Vec3::new(0.0, 0.0, 5.0)).unwrap()
+                * Transform::rotate(Vec3::X, 180.0).unwrap()),
+            false,
+        )
+        .unwrap();
+        let knot = TorusKnot::with_triangles(2000)
+            .mesh(&Transform::translate(Vec3::new(3.0, 0.0, 1.5)).unwrap())
+            .unwrap();
+        SceneGeometry::new(vec![
+            floor.into(),
+            ball.into(),
+            far_ball.into(),
+            lamp.into(),
+            knot.into(),
+        ])
+        .unwrap()
+    }
+
+    /// Rays of three kinds: from a camera (coherent), from random points in random
+    /// directions, and spawned from hits on the surfaces (the path tracer's secondary and
+    /// shadow rays, starting on a surface), with some lanes empty.
+    fn packets(geometry: &SceneGeometry, count: usize) -> Vec<[Option<Ray>; PACKET]> {
+        let mut rng = Pcg32::new(7, 1);
+        let mut out = Vec::new();
+        for n in 0..count {
+            let packet = std::array::from_fn(|i| {
+                let u = [
+                    rng.next_f64(),
+                    rng.next_f64(),
+                    rng.next_f64(),
+                    rng.next_f64(),
+                ];
+                let dir = square_to_uniform_sphere(Vec2::new(u[0], u[1]));
+                let ray = match n % 3 {
+                    0 => {
+                        let o = Vec3::new(0.5, -8.0, 3.0);
+                        let target = Vec3::new(8.0 * u[2] - 3.0, 0.0, 4.0 * u[3]);
+                        Ray::new(o, target - o, f64::INFINITY)
+                    }
+                    1 => {
+                        let o = Vec3::new(8.0 * u[2] - 4.0, 6.0 * u[3] - 3.0, 3.0 * u[2]);
+                        Ray::new(o, dir, if u[3] < 0.3 { 2.0 } else { f64::INFINITY })
+                    }
+                    _ => {
+                        let o = Vec3::new(8.0 * u[2] - 4.0, 6.0 * u[3] - 3.0, 6.0);
+                        let first = Ray::new(o, Vec3::new(u[0] - 0.5, u[1] - 0.5, -1.0), 1e9);
+                        match geometry.intersect_with(&first, HitDetail::Shading) {
+                            Some(h) if u[3] < 0.5 => h.spawn_ray(dir),
+                            Some(h) => h.spawn_ray_to(Vec3::new(0.0, 0.0, 4.9)),
+                            None => first,
+                        }
+                    }
+                };
+                (i != 3 || n % 4 != 0).then_some(ray)
+            });
+            out.push(packet);
+        }
+        out
+    }
+
+    /// Each lane finds the one-ray query's hit: the same primitive at the same distance
+    /// to the bit, and the same occlusion.
+    #[test]
+    fn packets_find_what_one_ray_queries_find() {
+        let geometry = scene();
+        let (mut hits, mut occluded) = (0, 0);
+        for rays in packets(&geometry, 3000) {
+            let packet = geometry.intersect_packet(&rays, HitDetail::Shading);
+            let blocked = geometry.occluded_packet(&rays);
+            for i in 0..PACKET {
+                let one = rays[i].and_then(|r| geometry.intersect_with(&r, HitDetail::Shading));
+                match (&one, &packet[i]) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert_eq!((a.shape, a.prim), (b.shape, b.prim), "lane {i}: {rays:?}");
+                        assert_eq!(a.t.to_bits(), b.t.to_bits());
+                        assert_eq!(a.p, b.p);
+                        hits += 1;
+                    }
+                    _ => panic!("lane {i}: one ray {one:?}, packet {:?}", packet[i]),
+                }
+                let one = rays[i].is_some_and(|r| geometry.occluded_ray(&r));
+                assert_eq!(one, blocked & (1 << i) != 0, "lane {i}: {:?}", rays[i]);
+                occluded += one as usize;
+            }
+        }
+        // Enough of each outcome for the comparison to mean something.
+        assert!(
+            hits > 6000 && occluded > 6000,
+            "{hits} hits, {occluded} occluded"
+        );
+    }
+}
