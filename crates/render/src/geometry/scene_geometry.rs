@@ -13,6 +13,8 @@ use rayon::prelude::*;
 
 mod packet;
 
+pub use packet::PacketHit;
+
 /// One BVH primitive: a triangle of a mesh or a whole analytic shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct PrimRef {

@@ -16,6 +16,7 @@
 //! off in the materials. On x86-64 the step is compiled twice, for the baseline (SSE2: an
 //! 8-lane operation is two instructions) and for AVX2 + FMA, chosen at run time.
 
+use crate::geometry::scene_geometry::PacketHit;
 use crate::geometry::{HitDetail, Ray, RayDifferential, SurfaceHit, Vec3};
 use crate::integrator::{
     light_numbers, power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS,
@@ -174,7 +175,7 @@ fn step<R: Real>(
     sums: &mut [PixelSums],
 ) {
     let rays: [Option<Ray>; LANES] = std::array::from_fn(|k| lanes[k].as_ref().map(|p| p.ray));
-    let hits = scene.geometry.intersect_packet(&rays, HitDetail::Shading);
+    let hits = scene.geometry.intersect_packet(&rays);
     let mut vertices: [Option<Vertex>; LANES] = Default::default();
     for ((lane, vertex), hit) in lanes.iter_mut().zip(vertices.iter_mut()).zip(hits) {
         let Some(path) = lane else { continue };
@@ -230,7 +231,7 @@ fn arrive<'s>(
     scene: &'s Scene,
     strategy: Strategy,
     path: &mut Path,
-    hit: Option<SurfaceHit>,
+    hit: Option<PacketHit>,
 ) -> Option<Vertex<'s>> {
     let ray = path.ray;
     let mis = |path: &Path, pl: f64| match strategy {
@@ -239,7 +240,7 @@ fn arrive<'s>(
         Strategy::NeeOnly => 0.0,
         Strategy::BsdfOnly => 1.0,
     };
-    let Some(mut hit) = hit else {
+    let Some(hit) = hit else {
         if let Some(env) = scene.environment {
             if let Light::Environment(e) = &scene.lights[env as usize] {
                 let pl = scene.selector.probability(env as usize) * e.pdf(ray.dir);
@@ -248,6 +249,9 @@ fn arrive<'s>(
         }
         return None;
     };
+    let mut hit = scene
+        .geometry
+        .packet_hit_record(&ray, hit, HitDetail::Shading);
     if let Some(li) = scene.shape_light[hit.shape as usize] {
         let light = &scene.lights[li as usize];
         let le = light.emitted(hit.ng, -ray.dir);

@@ -1,7 +1,7 @@
 //! Packet traversal: eight rays through the hierarchy together (Wald et al., "Interactive
 //! rendering with coherent ray tracing", 2001), for the packet kernel. A child is entered
 //! with the set of lanes whose ray meets its box, tested per lane exactly as the one-ray
-//! traversal tests it (the same f32 slab arithmetic lane by lane, so a lane never enters
+//! traversal tests it (the same f32 slab arithmetic as `RayBox` lane by lane, so a lane never enters
 //! fewer boxes than alone, and never finds another hit); a leaf is handed to the caller
 //! with that set, so that a primitive is tested for all its lanes in one lane call. The
 //! per-ray set-up (three divisions per ray) and each box test run eight lanes wide.
@@ -11,8 +11,7 @@
 //! be carried through boxes it misses (it is masked there, never tested against their
 //! primitives). docs/performance.md has the measured balance.
 
-use super::{f32_up, Bvh, RayBox, HI, SLAB_ROUNDING, STACK_SIZE, WIDTH};
-use crate::geometry::ray::Ray;
+use super::{f32_up, Bvh, HI, SLAB_ROUNDING, STACK_SIZE, WIDTH};
 use std::mem::MaybeUninit;
 
 /// Rays per packet.
@@ -34,7 +33,7 @@ pub fn lanes_of(set: Lanes) -> impl Iterator<Item = usize> {
     })
 }
 
-/// The box-test data of eight rays, lane by lane ([`RayBox`] transposed).
+/// The box-test data of eight rays, lane by lane (`RayBox` transposed).
 pub struct PacketBox {
     org_near: [[f32; PACKET]; 3],
     org_far: [[f32; PACKET]; 3],
@@ -45,21 +44,17 @@ pub struct PacketBox {
 }
 
 impl PacketBox {
-    /// The packet of `rays`; lanes outside `lanes` (or `None`) get harmless values and
-    /// must not be asked about. Rays of `lanes` need a finite origin and a finite non-zero
-    /// direction, as for [`RayBox`].
-    #[inline]
-    pub fn new(rays: &[Option<Ray>; PACKET], lanes: Lanes) -> PacketBox {
-        let ray = |i: usize| match &rays[i] {
-            Some(r) if lanes & (1 << i) != 0 => *r,
-            _ => Ray {
-                origin: crate::geometry::Vec3::ZERO,
-                dir: crate::geometry::Vec3::ONE,
-                t_max: 0.0,
-            },
-        };
-        let all: [Ray; PACKET] = std::array::from_fn(ray);
-        let scale: [f64; PACKET] = std::array::from_fn(|i| all[i].dir.abs().max_element());
+    /// The packet of rays with origins `o[axis][lane]` and directions `d[axis][lane]`.
+    /// Every lane needs a finite origin and a finite non-zero direction, as for `RayBox`
+    /// (callers give the lanes they will not ask about a harmless one). The one-ray
+    /// set-up's arithmetic (`RayBox::new`), written branch-free so that it runs eight
+    /// lanes wide.
+    #[inline(always)]
+    pub fn new(o: &[[f64; PACKET]; 3], d: &[[f64; PACKET]; 3]) -> PacketBox {
+        let mut scale = [0.0f64; PACKET];
+        for i in 0..PACKET {
+            scale[i] = d[0][i].abs().max(d[1][i].abs()).max(d[2][i].abs());
+        }
         let mut pb = PacketBox {
             org_near: [[0.0; PACKET]; 3],
             org_far: [[0.0; PACKET]; 3],
@@ -68,14 +63,14 @@ impl PacketBox {
             scale,
         };
         for a in 0..3 {
-            // The one-ray set-up's arithmetic (RayBox::new), eight divisions at a time.
-            let inv: [f64; PACKET] = std::array::from_fn(|i| scale[i] / all[i].dir[a]);
             for i in 0..PACKET {
-                let (near, far) = RayBox::rounded_origin(all[i].origin[a], inv[i]);
-                pb.inv[a][i] = inv[i] as f32;
-                pb.neg[a][i] = inv[i] < 0.0;
-                pb.org_near[a][i] = near;
-                pb.org_far[a][i] = far;
+                let inv = scale[i] / d[a][i];
+                let (up, down) = (f32_directed(o[a][i], true), f32_directed(o[a][i], false));
+                let neg = inv < 0.0;
+                pb.inv[a][i] = inv as f32;
+                pb.neg[a][i] = neg;
+                pb.org_near[a][i] = if neg { down } else { up };
+                pb.org_far[a][i] = if neg { up } else { down };
             }
         }
         pb
@@ -118,6 +113,34 @@ impl PacketBox {
     }
 }
 
+/// `x` rounded to f32 upwards (`up`) or downwards: `f32_up`/`f32_down` of the one-ray
+/// set-up without branches. The nearest f32 is moved one step where it lies on the wrong
+/// side of `x`: away from zero when the step's direction matches its sign, towards zero
+/// otherwise, and from ±0 to the smallest subnormal of the step's sign.
+#[inline(always)]
+fn f32_directed(x: f64, up: bool) -> f32 {
+    let f = x as f32;
+    let back = f as f64;
+    let wrong = if up { back < x } else { back > x };
+    let bits = f.to_bits();
+    let moved = if f == 0.0 {
+        if up {
+            1
+        } else {
+            0x8000_0001
+        }
+    } else if (f > 0.0) == up {
+        bits.wrapping_add(1)
+    } else {
+        bits.wrapping_sub(1)
+    };
+    if wrong {
+        f32::from_bits(moved)
+    } else {
+        f
+    }
+}
+
 /// A pending child: a wide node (`count == 0`) or a leaf's slots, with the lanes that
 /// entered it and their entry distances.
 #[derive(Clone, Copy)]
@@ -141,6 +164,7 @@ impl Bvh {
     /// the primitive in `slot` with the rays of `lanes` restricted to `(0, t_max[i]]`,
     /// lowers `t_max[i]` for each lane it hits (keeping the hit itself), and returns those
     /// lanes. Children are visited nearest-first by their lanes' smallest entry distance.
+    #[inline(always)]
     pub fn closest_hit_packet(
         &self,
         pb: &PacketBox,
@@ -230,6 +254,7 @@ impl Bvh {
     /// Which rays of `lanes` hit anything in `(0, t_max[i]]`. `test(slot, lanes)` returns
     /// the lanes among `lanes` whose ray hits the primitive in `slot`; a lane stops at its
     /// first hit, the traversal when every lane has stopped.
+    #[inline(always)]
     pub fn any_hit_packet(
         &self,
         pb: &PacketBox,
@@ -300,6 +325,36 @@ impl Bvh {
                     break;
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{f32_down, f32_up};
+    use super::*;
+
+    #[test]
+    fn branch_free_rounding_is_the_one_ray_rounding() {
+        let mut values = vec![
+            0.0, -0.0, 1e-320, -1e-320, 1e-40, -1e-40, 1e30, -1e30, 1e39, -1e39,
+        ];
+        let mut x = 1.234_567_890_123e-5_f64;
+        while x < 1e31 {
+            values.extend([x, -x, (x as f32) as f64, -((x as f32) as f64)]);
+            x *= 1.37;
+        }
+        for v in values {
+            assert_eq!(
+                f32_directed(v, true).to_bits(),
+                f32_up(v).to_bits(),
+                "{v:e} up"
+            );
+            assert_eq!(
+                f32_directed(v, false).to_bits(),
+                f32_down(v).to_bits(),
+                "{v:e} down"
+            );
         }
     }
 }

@@ -12,28 +12,58 @@ use crate::geometry::ray::Ray;
 use crate::geometry::shape::Shape;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::TriangleRay;
-use crate::geometry::{Vec2, Vec3};
+use crate::geometry::Vec2;
 use facette_bsdf::lanes::{F64x4, LVec3};
 
-/// The packet's rays as two groups of four f64 lanes.
+/// A packet lane's closest hit: the primitive's slot in the BVH order and the hit.
+#[derive(Clone, Copy, Debug)]
+pub struct PacketHit {
+    slot: u32,
+    hit: PrimHit,
+}
+
+/// The packet's rays in lanes: f64 coordinates per axis (lanes without a valid ray hold
+/// a harmless one), and as two groups of four f64 lanes for the sphere test.
 struct LaneRays {
-    o: [LVec3<F64x4>; 2],
-    d: [LVec3<F64x4>; 2],
+    o: [[f64; PACKET]; 3],
+    d: [[f64; PACKET]; 3],
+    t_max: [f64; PACKET],
+    /// The lanes with a valid ray.
+    lanes: Lanes,
 }
 
 impl LaneRays {
-    #[inline]
+    #[inline(always)]
     fn new(rays: &[Option<Ray>; PACKET]) -> LaneRays {
-        let get = |i: usize, f: fn(&Ray) -> Vec3| rays[i].as_ref().map_or(Vec3::ZERO, f);
-        let group = |h: usize, f: fn(&Ray) -> Vec3| LVec3::from_fn(|j| get(4 * h + j, f));
-        LaneRays {
-            o: [group(0, |r| r.origin), group(1, |r| r.origin)],
-            d: [group(0, |r| r.dir), group(1, |r| r.dir)],
+        let mut r = LaneRays {
+            o: [[0.0; PACKET]; 3],
+            d: [[1.0; PACKET]; 3],
+            t_max: [0.0; PACKET],
+            lanes: 0,
+        };
+        for (i, ray) in rays.iter().enumerate() {
+            let Some(ray) = ray.filter(is_valid_query) else {
+                continue;
+            };
+            for a in 0..3 {
+                r.o[a][i] = ray.origin[a];
+                r.d[a][i] = ray.dir[a];
+            }
+            r.t_max[i] = ray.t_max;
+            r.lanes |= 1 << i;
         }
+        r
+    }
+
+    /// Group `h` (lanes 4h..4h + 4) of the coordinates `c`.
+    #[inline(always)]
+    fn group(c: &[[f64; PACKET]; 3], h: usize) -> LVec3<F64x4> {
+        let g = |a: usize| F64x4(std::array::from_fn(|j| c[a][4 * h + j]));
+        LVec3::new(g(0), g(1), g(2))
     }
 
     /// The lanes of `lanes` whose ray hits `sphere` in `(0, t_max[i]]`, with the distance.
-    #[inline]
+    #[inline(always)]
     fn sphere(
         &self,
         sphere: &Sphere,
@@ -47,7 +77,8 @@ impl LaneRays {
                 continue;
             }
             let limit = F64x4(std::array::from_fn(|j| t_max[4 * h + j]));
-            let (m, th) = sphere.intersect_lanes(self.o[h], self.d[h], limit);
+            let (o, d) = (Self::group(&self.o, h), Self::group(&self.d, h));
+            let (m, th) = sphere.intersect_lanes(o, d, limit);
             hit |= (m.bits() as Lanes) << (4 * h);
             t[4 * h..4 * h + 4].copy_from_slice(&th.0);
         }
@@ -55,76 +86,75 @@ impl LaneRays {
     }
 }
 
-/// The lanes whose ray can be queried.
-#[inline]
-fn valid_lanes(rays: &[Option<Ray>; PACKET]) -> Lanes {
-    (0..PACKET).fold(0, |set, i| {
-        set | ((matches!(&rays[i], Some(r) if is_valid_query(r)) as Lanes) << i)
-    })
-}
-
 impl SceneGeometry {
-    /// [`intersect_with`](Self::intersect_with) for every ray of a packet (`None` lanes
-    /// hit nothing).
-    pub fn intersect_packet(
-        &self,
-        rays: &[Option<Ray>; PACKET],
-        detail: HitDetail,
-    ) -> [Option<SurfaceHit>; PACKET] {
-        let lanes = valid_lanes(rays);
-        let mut best: [Option<(usize, PrimHit)>; PACKET] = [None; PACKET];
-        if lanes != 0 {
-            let pb = PacketBox::new(rays, lanes);
-            let lane_rays = LaneRays::new(rays);
-            let mut t_max: [f64; PACKET] =
-                std::array::from_fn(|i| rays[i].map_or(0.0, |r| r.t_max));
-            let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
-            self.bvh
-                .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
-                    let mut found = 0;
-                    if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
-                        let (hit, t) = lane_rays.sphere(s, lanes, t_max);
-                        for i in lanes_of(hit) {
-                            t_max[i] = t[i];
-                            best[i] = Some((
-                                slot,
-                                PrimHit {
-                                    t: t[i],
-                                    local: Vec2::ZERO,
-                                },
-                            ));
-                        }
-                        return hit;
-                    }
-                    for i in lanes_of(lanes) {
-                        let Some(ray) = &rays[i] else { continue };
-                        if let Some(h) = self.test_prim(slot, ray, &mut tri[i], t_max[i]) {
-                            if h.t <= t_max[i] {
-                                t_max[i] = h.t;
-                                best[i] = Some((slot, h));
-                                found |= 1 << i;
-                            }
-                        }
-                    }
-                    found
-                });
+    /// The closest hit of every ray of a packet (`None` lanes hit nothing), as the
+    /// primitive's slot and its hit; [`packet_hit_record`](Self::packet_hit_record) makes
+    /// the surface record of one, so the kernel moves 24 bytes per lane, not a record.
+    #[inline(always)]
+    pub fn intersect_packet(&self, rays: &[Option<Ray>; PACKET]) -> [Option<PacketHit>; PACKET] {
+        let lane_rays = LaneRays::new(rays);
+        let lanes = lane_rays.lanes;
+        let mut best: [Option<PacketHit>; PACKET] = [None; PACKET];
+        if lanes == 0 {
+            return best;
         }
-        std::array::from_fn(|i| {
-            let (slot, hit) = best[i]?;
-            Some(self.hit_record(slot, rays[i].as_ref()?, hit, detail))
-        })
+        let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
+        let mut t_max = lane_rays.t_max;
+        let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
+        self.bvh
+            .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
+                if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
+                    let (hit, t) = lane_rays.sphere(s, lanes, t_max);
+                    for i in lanes_of(hit) {
+                        t_max[i] = t[i];
+                        best[i] = Some(PacketHit {
+                            slot: slot as u32,
+                            hit: PrimHit {
+                                t: t[i],
+                                local: Vec2::ZERO,
+                            },
+                        });
+                    }
+                    return hit;
+                }
+                let mut found = 0;
+                for i in lanes_of(lanes) {
+                    let Some(ray) = &rays[i] else { continue };
+                    if let Some(h) = self.test_prim(slot, ray, &mut tri[i], t_max[i]) {
+                        if h.t <= t_max[i] {
+                            t_max[i] = h.t;
+                            best[i] = Some(PacketHit {
+                                slot: slot as u32,
+                                hit: h,
+                            });
+                            found |= 1 << i;
+                        }
+                    }
+                }
+                found
+            });
+        best
+    }
+
+    /// The surface record of `ray`'s hit `hit` found by
+    /// [`intersect_packet`](Self::intersect_packet), with the details asked for: what
+    /// [`intersect_with`](Self::intersect_with) returns for that ray.
+    #[inline]
+    pub fn packet_hit_record(&self, ray: &Ray, hit: PacketHit, detail: HitDetail) -> SurfaceHit {
+        self.hit_record(hit.slot as usize, ray, hit.hit, detail)
     }
 
     /// [`occluded_ray`](Self::occluded_ray) for every ray of a packet: the occluded lanes
     /// (`None` lanes are not).
+    #[inline(always)]
     pub fn occluded_packet(&self, rays: &[Option<Ray>; PACKET]) -> Lanes {
-        let lanes = valid_lanes(rays);
+        let lane_rays = LaneRays::new(rays);
+        let lanes = lane_rays.lanes;
         if lanes == 0 {
             return 0;
         }
-        let pb = PacketBox::new(rays, lanes);
-        let lane_rays = LaneRays::new(rays);
-        let t_max: [f64; PACKET] = std::array::from_fn(|i| rays[i].map_or(0.0, |r| r.t_max));
+        let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
+        let t_max = lane_rays.t_max;
         let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
         self.bvh.any_hit_packet(&pb, lanes, &t_max, |slot, lanes| {
             if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
@@ -144,7 +174,7 @@ impl SceneGeometry {
 mod tests {
     use super::*;
     use crate::geometry::generate::TorusKnot;
-    use crate::geometry::{Disk, Rectangle, Transform};
+    use crate::geometry::{Disk, Rectangle, Transform, Vec3};
     use facette_bsdf::math::rng::{Pcg32, RandomSource};
     use facette_bsdf::math::warp::square_to_uniform_sphere;
 
@@ -226,11 +256,14 @@ mod tests {
         let geometry = scene();
         let (mut hits, mut occluded) = (0, 0);
         for rays in packets(&geometry, 3000) {
-            let packet = geometry.intersect_packet(&rays, HitDetail::Shading);
+            let packet = geometry.intersect_packet(&rays);
             let blocked = geometry.occluded_packet(&rays);
             for i in 0..PACKET {
                 let one = rays[i].and_then(|r| geometry.intersect_with(&r, HitDetail::Shading));
-                match (&one, &packet[i]) {
+                let packet = packet[i].map(|h| {
+                    geometry.packet_hit_record(rays[i].as_ref().unwrap(), h, HitDetail::Shading)
+                });
+                match (&one, &packet) {
                     (None, None) => {}
                     (Some(a), Some(b)) => {
                         assert_eq!((a.shape, a.prim), (b.shape, b.prim), "lane {i}: {rays:?}");
@@ -238,7 +271,7 @@ mod tests {
                         assert_eq!(a.p, b.p);
                         hits += 1;
                     }
-                    _ => panic!("lane {i}: one ray {one:?}, packet {:?}", packet[i]),
+                    _ => panic!("lane {i}: one ray {one:?}, packet {packet:?}"),
                 }
                 let one = rays[i].is_some_and(|r| geometry.occluded_ray(&r));
                 assert_eq!(one, blocked & (1 << i) != 0, "lane {i}: {:?}", rays[i]);
