@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 mod packet;
 
-pub use packet::PacketHit;
+pub use packet::{PacketHit, PACKET_TRAVERSAL_MAX_NODES};
 
 /// One BVH primitive: a triangle of a mesh or a whole analytic shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,6 +32,9 @@ pub struct SceneGeometry {
     prims: Vec<PrimRef>,
     bvh: Bvh,
     bounds: Bounds3,
+    /// Whether packet queries traverse the hierarchy as packets
+    /// ([`packet::PACKET_TRAVERSAL_MAX_NODES`]).
+    packet_traversal: bool,
 }
 
 impl SceneGeometry {
@@ -63,6 +66,7 @@ impl SceneGeometry {
         Ok(SceneGeometry {
             shapes,
             prims,
+            packet_traversal: bvh.node_count() <= packet::PACKET_TRAVERSAL_MAX_NODES,
             bvh,
             bounds,
         })
@@ -166,15 +170,22 @@ impl SceneGeometry {
     /// material without textures or glints reads (the shading frame normalizes `dpdu`).
     /// Complete such a hit later with [`complete_hit`](Self::complete_hit).
     pub fn intersect_with(&self, ray: &Ray, detail: HitDetail) -> Option<SurfaceHit> {
+        let (slot, hit) = self.closest_slot(ray)?;
+        Some(self.hit_record(slot, ray, hit, detail))
+    }
+
+    /// The slot of the primitive `ray` hits first, and the hit.
+    #[inline]
+    fn closest_slot(&self, ray: &Ray) -> Option<(usize, PrimHit)> {
         if !is_valid_query(ray) {
             return None;
         }
         let mut tri = None;
-        let (_, (slot, hit)) = self.bvh.closest_hit(ray, |slot, t_max| {
+        let (_, found) = self.bvh.closest_hit(ray, |slot, t_max| {
             self.test_prim(slot, ray, &mut tri, t_max)
                 .map(|h| (h.t, (slot, h)))
         })?;
-        Some(self.hit_record(slot, ray, hit, detail))
+        Some(found)
     }
 
     /// The surface details of `ray`'s hit `hit` on the primitive in `slot`.

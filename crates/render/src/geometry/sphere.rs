@@ -30,7 +30,7 @@ use super::ray::Ray;
 use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
-use facette_bsdf::lanes::{LVec3, Real};
+use facette_bsdf::lanes::{LVec3, Mask, Real};
 use facette_bsdf::math::warp::square_to_uniform_sphere;
 use facette_bsdf::math::Frame;
 use std::f64::consts::{PI, TAU};
@@ -148,6 +148,11 @@ impl Sphere {
         let c = o.length_squared() - r * r;
         let closest = (o - d.scale(half_b / a)).length_squared().sqrt();
         let disc = a * (r + closest) * (r - closest);
+        // Every lane misses (one ray: this ray misses): skip the roots.
+        let real = a.gt(zero) & disc.ge(zero);
+        if real.none() {
+            return (real, zero);
+        }
         let root = disc.sqrt();
         let q = R::select(half_b.gt(zero), -(half_b + root), -(half_b - root));
         let (r0, r1) = (q / a, c / q);
@@ -157,7 +162,7 @@ impl Sphere {
         // false for NaN lanes (a zero direction, a negative discriminant's root); a NaN
         // root is refused before `min` could drop it.
         let ordered = r0.eq(r0) & r1.eq(r1);
-        let hit = a.gt(zero) & disc.ge(zero) & !q.eq(zero) & ordered & t0.le(t_max) & t1.gt(zero);
+        let hit = real & !q.eq(zero) & ordered & t0.le(t_max) & t1.gt(zero);
         (hit & t.le(t_max), t)
     }
 

@@ -86,15 +86,43 @@ impl LaneRays {
     }
 }
 
+/// The largest hierarchy (in wide nodes) traversed by packets; larger ones are traversed
+/// one lane at a time. On the 1M-triangle mesh scene (`scenes/mesh.toml`), whose
+/// secondary rays scatter over the mesh, packet traversal rendered at 0.75–0.8× the speed
+/// of one-ray traversal (the lanes are carried through each other's boxes, and triangles
+/// are tested lane by lane anyway); on scenes of a few shapes it is the faster one
+/// (docs/performance.md).
+pub const PACKET_TRAVERSAL_MAX_NODES: usize = 64;
+
 impl SceneGeometry {
+    /// Whether the packet queries traverse the hierarchy as packets
+    /// ([`PACKET_TRAVERSAL_MAX_NODES`]); otherwise they query lane by lane, with the same
+    /// results.
+    #[inline]
+    pub fn packet_traversal(&self) -> bool {
+        self.packet_traversal
+    }
+
     /// The closest hit of every ray of a packet (`None` lanes hit nothing), as the
     /// primitive's slot and its hit; [`packet_hit_record`](Self::packet_hit_record) makes
     /// the surface record of one, so the kernel moves 24 bytes per lane, not a record.
     #[inline(always)]
     pub fn intersect_packet(&self, rays: &[Option<Ray>; PACKET]) -> [Option<PacketHit>; PACKET] {
+        let mut best: [Option<PacketHit>; PACKET] = [None; PACKET];
+        if !self.packet_traversal() {
+            for (b, ray) in best.iter_mut().zip(rays) {
+                *b = ray
+                    .as_ref()
+                    .and_then(|r| self.closest_slot(r))
+                    .map(|(slot, hit)| PacketHit {
+                        slot: slot as u32,
+                        hit,
+                    });
+            }
+            return best;
+        }
         let lane_rays = LaneRays::new(rays);
         let lanes = lane_rays.lanes;
-        let mut best: [Option<PacketHit>; PACKET] = [None; PACKET];
         if lanes == 0 {
             return best;
         }
@@ -148,6 +176,12 @@ impl SceneGeometry {
     /// (`None` lanes are not).
     #[inline(always)]
     pub fn occluded_packet(&self, rays: &[Option<Ray>; PACKET]) -> Lanes {
+        if !self.packet_traversal() {
+            return (0..PACKET).fold(0, |set, i| {
+                let occluded = rays[i].as_ref().is_some_and(|r| self.occluded_ray(r));
+                set | ((occluded as Lanes) << i)
+            });
+        }
         let lane_rays = LaneRays::new(rays);
         let lanes = lane_rays.lanes;
         if lanes == 0 {
@@ -253,9 +287,19 @@ mod tests {
     /// to the bit, and the same occlusion.
     #[test]
     fn packets_find_what_one_ray_queries_find() {
-        let geometry = scene();
+        let mut geometry = scene();
+        // The knot's hierarchy is beyond the packet traversal's limit: both ways, packet
+        // traversal first.
+        assert!(!geometry.packet_traversal());
+        for packet_traversal in [true, false] {
+            geometry.packet_traversal = packet_traversal;
+            compare_with_one_ray_queries(&geometry);
+        }
+    }
+
+    fn compare_with_one_ray_queries(geometry: &SceneGeometry) {
         let (mut hits, mut occluded) = (0, 0);
-        for rays in packets(&geometry, 3000) {
+        for rays in packets(geometry, 3000) {
             let packet = geometry.intersect_packet(&rays);
             let blocked = geometry.occluded_packet(&rays);
             for i in 0..PACKET {
