@@ -11,7 +11,7 @@ use facette_bsdf::validation::bsdf_checks::{
 };
 use facette_bsdf::validation::chi2::Chi2Config;
 use facette_bsdf::validation::Report;
-use facette_bsdf::{Bsdf, BsdfContext, TransportMode};
+use facette_bsdf::{Bsdf, BsdfContext, Spectrum, TransportMode};
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -179,9 +179,12 @@ impl Material {
     /// and `wo` (toward the viewer), both (N, 3) in the local frame (z = normal). Stochastic
     /// materials average `samples` estimates per row from one stream seeded by `seed` —
     /// the values `facette eval` prints for the same rows, seed and samples — and so run on
-    /// one thread; the others run on `threads` threads (all cores when None).
+    /// one thread; the others run on `threads` threads (all cores when None). With
+    /// `with_error`, three more columns: each value's error (`facette eval --with-error`'s:
+    /// the standard error of stochastic estimates, the adaptive quadrature's error
+    /// estimate, 0 for closed forms).
     #[pyo3(signature = (wi, wo, samples = 100_000, mode = "radiance", seed = 1, threads = None,
-        progress = None))]
+        progress = None, with_error = false))]
     #[allow(clippy::too_many_arguments)]
     fn eval<'py>(
         &self,
@@ -193,6 +196,7 @@ impl Material {
         seed: u64,
         threads: Option<usize>,
         progress: Option<Py<PyAny>>,
+        with_error: bool,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let ctx = context(mode)?;
         let (wi, wo) = (directions(&wi, "wi")?, directions(&wo, "wo")?);
@@ -221,13 +225,13 @@ impl Material {
                 // One stream through the rows, in order: `facette eval`'s values.
                 c.set_total(wi.len() as u64);
                 let mut rng = Pcg32::new(seed, 0);
-                let mut out = vec![[0.0; 3]; wi.len()];
+                let mut out = vec![[0.0; 6]; wi.len()];
                 for k in 0..wi.len() {
                     if c.cancelled() {
                         break;
                     }
-                    let (f, _) = bsdf.eval_estimate(wo[k], wi[k], &ctx, samples, &mut rng);
-                    out[k] = [f[0], f[1], f[2]];
+                    let (f, e) = bsdf.eval_estimate(wo[k], wi[k], &ctx, samples, &mut rng);
+                    out[k] = [f[0], f[1], f[2], e[0], e[1], e[2]];
                     c.advance(1);
                 }
                 out
@@ -235,14 +239,20 @@ impl Material {
                 par_rows(&pool, c, wi.len(), |k| {
                     // Deterministic: the generator is not drawn from.
                     let mut rng = Pcg32::new(seed, k as u64);
-                    let f = bsdf.eval(wo[k], wi[k], &ctx, &mut rng);
-                    [f[0], f[1], f[2]]
+                    // The error estimate only where asked: it may cost more than the value.
+                    let (f, e) = if with_error {
+                        bsdf.eval_estimate(wo[k], wi[k], &ctx, samples, &mut rng)
+                    } else {
+                        (bsdf.eval(wo[k], wi[k], &ctx, &mut rng), Spectrum::ZERO)
+                    };
+                    [f[0], f[1], f[2], e[0], e[1], e[2]]
                 })
             }
         })?;
-        let mut out = Array2::<f64>::zeros((rows.len(), 3));
+        let columns = if with_error { 6 } else { 3 };
+        let mut out = Array2::<f64>::zeros((rows.len(), columns));
         for (k, f) in rows.iter().enumerate() {
-            for c in 0..3 {
+            for c in 0..columns {
                 out[[k, c]] = f[c];
             }
         }

@@ -43,6 +43,40 @@ def test_eval_equals_the_cli(facette_bin, spec, samples):
     np.testing.assert_allclose(py, cli, rtol=1e-9, atol=1e-300)
 
 
+@pytest.mark.parametrize(
+    "spec, samples",
+    [
+        # Adaptive quadrature: the error column is its error estimate.
+        ('{type = "il", kd = 0.7, ni = 1.5, alpha = 0.4, evaluation = "quadrature", tolerance = 1e-4}', 1),
+        # Stochastic: the standard error of the mean.
+        ('{type = "il", kd = 0.7, ni = 1.5, alpha = 0.4}', 300),
+        # Closed form: zero.
+        ('{type = "conductor", material = "Au", distribution = "ggx", alpha = 0.3}', 1),
+    ],
+)
+def test_eval_with_error_equals_the_cli(facette_bin, spec, samples):
+    csv = "\n".join(",".join(f"{v:g}" for v in r) for r in ROWS)
+    out = subprocess.run(
+        [facette_bin, "eval", "--material", spec, "--samples", str(samples), "--seed", "4", "--with-error"],
+        input=csv, capture_output=True, text=True, check=True,
+    ).stdout
+    cli = np.array([[float(x) for x in line.split(",")[4:]] for line in out.strip().splitlines()[1:]])
+    m = facette.Material(spec)
+    wi = spherical(ROWS[:, 0], ROWS[:, 1])
+    wo = spherical(ROWS[:, 2], ROWS[:, 3])
+    f, err = m.eval(wi, wo, samples=samples, seed=4, with_error=True)
+    assert f.shape == err.shape == (len(ROWS), 3)
+    np.testing.assert_allclose(f, cli[:, :3], rtol=1e-9, atol=1e-300)
+    # The CLI prints errors with 4 significant digits.
+    np.testing.assert_allclose(err, cli[:, 3:], rtol=1e-3, atol=1e-300)
+    np.testing.assert_array_equal(m.eval(wi, wo, samples=samples, seed=4), f)
+    if "conductor" in spec:
+        assert (err == 0).all()
+    else:
+        assert (err[f[:, 0] > 0] > 0).all()
+        assert (err < 0.05 * np.maximum(f, 1e-3)).all()
+
+
 def test_dict_specs_equal_toml_specs():
     a = facette.Material({"type": "conductor", "material": "Cu", "distribution": "ggx", "alpha_u": 0.1, "alpha_v": 0.4})
     b = facette.Material('{type = "conductor", material = "Cu", distribution = "ggx", alpha_u = 0.1, alpha_v = 0.4}')

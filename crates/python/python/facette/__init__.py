@@ -187,7 +187,10 @@ class Material:
         return f"Material({self.toml})"
 
     @_entry("facette.Material.eval")
-    def eval(self, wi, wo, samples=100_000, mode="radiance", seed=1, *, cosine=False, threads=None, progress=False):
+    def eval(
+        self, wi, wo, samples=100_000, mode="radiance", seed=1, *, cosine=False, threads=None, progress=False,
+        with_error=False,
+    ):
         """f(wi, wo) per RGB channel: an array of shape ``broadcast(wi, wo)[:-1] + (3,)``.
 
         ``wi`` points toward the light, ``wo`` toward the viewer, both (..., 3) arrays in
@@ -200,16 +203,27 @@ class Material:
         threads (all cores by default; results do not depend on it). ``mode`` is
         "radiance" or "importance" (they differ for refraction). ``progress``: True prints
         the rows done on stderr, a callable receives ``(done, total)``.
+
+        ``with_error=True`` returns ``(f, err)``, ``err`` of ``f``'s shape: each value's
+        error, as ``facette eval --with-error`` prints it — the standard error of a
+        stochastic mean, the adaptive quadrature's error estimate (``evaluation =
+        "quadrature"``), their root sum of squares where a value adds both, 0 for closed
+        forms and tables.
         """
         samples = _count(samples, "samples", 1)
         seed = _count(seed, "seed")
         threads = _count(threads, "threads", 1, optional=True)
         wi_rows, wo_rows, shape = _pair(wi, wo)
-        f = self._m.eval(wi_rows, wo_rows, samples, mode, seed, threads, _progress(progress, "eval"))
+        rows = self._m.eval(
+            wi_rows, wo_rows, samples, mode, seed, threads, _progress(progress, "eval"), bool(with_error)
+        )
         if cosine:
             n = _np.linalg.norm(wi_rows, axis=1, keepdims=True)
-            f = f * _np.abs(wi_rows[:, 2:3]) / _np.where(n > 0, n, 1.0)
-        return f.reshape(shape + (3,))
+            rows = rows * _np.abs(wi_rows[:, 2:3]) / _np.where(n > 0, n, 1.0)
+        f = rows[:, :3].reshape(shape + (3,))
+        if with_error:
+            return f, rows[:, 3:].reshape(shape + (3,))
+        return f
 
     @_entry("facette.Material.pdf")
     def pdf(self, wi, wo, mode="radiance", *, threads=None):

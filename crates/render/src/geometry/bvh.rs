@@ -156,6 +156,15 @@ struct WideNode {
     count: [u8; WIDTH],
 }
 
+impl WideNode {
+    /// Whether child slot `k` is unused (an empty box leading nowhere: child 0 of an
+    /// interior slot, since the root is nobody's child).
+    #[inline(always)]
+    fn unused(&self, k: usize) -> bool {
+        self.count[k] == 0 && self.child[k] == 0
+    }
+}
+
 const EMPTY_WIDE: WideNode = WideNode {
     bounds: [
         [f32::INFINITY; WIDTH],
@@ -242,6 +251,19 @@ impl Bvh {
         }
     }
 
+    /// The slots of the whole hierarchy when it is a single leaf (at most
+    /// [`MAX_LEAF`] primitives): queries may then test them without any box test.
+    #[inline]
+    pub fn single_leaf(&self) -> Option<std::ops::Range<usize>> {
+        match self.nodes.as_slice() {
+            [root] if root.count[0] > 0 && (1..WIDTH).all(|k| root.unused(k)) => {
+                let first = root.child[0] as usize;
+                Some(first..first + root.count[0] as usize)
+            }
+            _ => None,
+        }
+    }
+
     /// Primitive index of each slot: leaves refer to slots `first..first + count`.
     #[inline]
     pub fn order(&self) -> &[u32] {
@@ -265,8 +287,7 @@ impl Bvh {
             let n = &nodes[i];
             let mut d = 1;
             for k in 0..WIDTH {
-                // Unused slots (child 0: the root is nobody's child) lead nowhere.
-                if n.count[k] == 0 && n.child[k] != 0 {
+                if !n.unused(k) && n.count[k] == 0 {
                     d = d.max(rec(nodes, n.child[k] as usize));
                 }
             }

@@ -3,18 +3,24 @@
 //! from the row's remaining (pixel, sample) jobs so that the lanes stay full.
 //!
 //! A step is the scalar integrator's vertex ([`integrator`](crate::integrator)) in phases,
-//! each over all lanes: intersection, emission and the vertex's frame (per lane); light
-//! samples (per lane); the material's value and density for every light sample (one call
-//! over eight lanes per material that has a lane model, `facette_bsdf::lanes::LaneBsdf`;
-//! the f64 model lane by lane otherwise); shadow rays (per lane); the material's samples
-//! (one call over eight lanes again); throughput, roulette and the next ray (per lane).
+//! each over all lanes: intersection (one packet query for the eight rays,
+//! [`intersect_packet`](crate::geometry::SceneGeometry::intersect_packet)), emission and
+//! the vertex's frame (per lane); light samples (per lane); the material's value and
+//! density for every light sample (one call over eight lanes per material that has a lane
+//! model, `facette_bsdf::lanes::LaneBsdf`; the f64 model lane by lane otherwise); shadow
+//! rays (one packet query,
+//! [`occluded_packet`](crate::geometry::SceneGeometry::occluded_packet)); the material's
+//! samples (one call over eight lanes again); throughput, roulette and the next ray (per
+//! lane).
 //! The random numbers are the scalar integrator's, dimension for dimension, from the same
 //! sample streams, so the two kernels' images differ only by the f32 rounding of the lane
 //! models (and, where a rounding moves a path across a decision, by that path).
 //!
-//! Geometry, lights and the film stay f64 and per lane in this version; the lane width pays
-//! off in the materials. On x86-64 the step is compiled twice, for the baseline (SSE2: an
-//! 8-lane operation is two instructions) and for AVX2 + FMA, chosen at run time.
+//! The packet queries find each lane's hit in f64, exactly as a one-ray query does
+//! (spheres four lanes at a time by their one-source test); lights, the camera, the
+//! sampler and the film stay f64 and per lane in this version. On x86-64 the step is
+//! compiled twice, for the baseline (SSE2: an 8-lane operation is two instructions) and
+//! for AVX2 + FMA, chosen at run time.
 
 use crate::geometry::scene_geometry::PacketHit;
 use crate::geometry::{HitDetail, Ray, RayDifferential, SurfaceHit, Vec3};

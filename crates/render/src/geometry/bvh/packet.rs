@@ -38,8 +38,9 @@ pub struct PacketBox {
     org_near: [[f32; PACKET]; 3],
     org_far: [[f32; PACKET]; 3],
     inv: [[f32; PACKET]; 3],
-    /// Whether the direction is negative along the axis (the near plane is then `hi`).
-    neg: [[bool; PACKET]; 3],
+    /// All bits set where the direction is negative along the axis (the near plane is
+    /// then `hi`): a bit mask, so that choosing the planes is a vector blend.
+    neg: [[u32; PACKET]; 3],
     scale: [f64; PACKET],
 }
 
@@ -59,18 +60,18 @@ impl PacketBox {
             org_near: [[0.0; PACKET]; 3],
             org_far: [[0.0; PACKET]; 3],
             inv: [[0.0; PACKET]; 3],
-            neg: [[false; PACKET]; 3],
+            neg: [[0; PACKET]; 3],
             scale,
         };
         for a in 0..3 {
             for i in 0..PACKET {
                 let inv = scale[i] / d[a][i];
                 let (up, down) = (f32_directed(o[a][i], true), f32_directed(o[a][i], false));
-                let neg = inv < 0.0;
+                let neg = 0u32.wrapping_sub((inv < 0.0) as u32);
                 pb.inv[a][i] = inv as f32;
                 pb.neg[a][i] = neg;
-                pb.org_near[a][i] = if neg { down } else { up };
-                pb.org_far[a][i] = if neg { up } else { down };
+                pb.org_near[a][i] = blend(neg, down, up);
+                pb.org_far[a][i] = blend(neg, up, down);
             }
         }
         pb
@@ -97,7 +98,8 @@ impl PacketBox {
         for a in 0..3 {
             let (lo, hi) = (node.bounds[a][k], node.bounds[HI + a][k]);
             for i in 0..PACKET {
-                let (near, far) = if self.neg[a][i] { (hi, lo) } else { (lo, hi) };
+                let m = self.neg[a][i];
+                let (near, far) = (blend(m, hi, lo), blend(m, lo, hi));
                 let tn = (near - self.org_near[a][i]) * self.inv[a][i];
                 let tf = (far - self.org_far[a][i]) * self.inv[a][i];
                 // As in the one-ray test: comparisons that ignore a NaN slab distance.
@@ -123,22 +125,22 @@ fn f32_directed(x: f64, up: bool) -> f32 {
     let back = f as f64;
     let wrong = if up { back < x } else { back > x };
     let bits = f.to_bits();
+    // ±1 in two's complement: +1 where the step moves away from zero.
+    let away = (f > 0.0) == up;
+    let step = 1u32.wrapping_sub(2 * !away as u32);
+    let from_zero = if up { 1 } else { 0x8000_0001 };
     let moved = if f == 0.0 {
-        if up {
-            1
-        } else {
-            0x8000_0001
-        }
-    } else if (f > 0.0) == up {
-        bits.wrapping_add(1)
+        from_zero
     } else {
-        bits.wrapping_sub(1)
+        bits.wrapping_add(step)
     };
-    if wrong {
-        f32::from_bits(moved)
-    } else {
-        f
-    }
+    f32::from_bits(if wrong { moved } else { bits })
+}
+
+/// `a` where the mask `m` has its bits set, else `b` (a vector blend).
+#[inline(always)]
+fn blend(m: u32, a: f32, b: f32) -> f32 {
+    f32::from_bits((m & a.to_bits()) | (!m & b.to_bits()))
 }
 
 /// A pending child: a wide node (`count == 0`) or a leaf's slots, with the lanes that
@@ -192,6 +194,9 @@ impl Bvh {
                 let mut keys = [0.0f32; WIDTH];
                 let mut n = 0;
                 for k in 0..WIDTH {
+                    if node.unused(k) {
+                        continue;
+                    }
                     let (hit, t0) = pb.hits(node, k, cur.lanes, &limit);
                     if hit == 0 {
                         continue;
@@ -281,6 +286,9 @@ impl Bvh {
                 let node = &self.nodes[cur.index as usize];
                 let mut next: Option<PacketEntry> = None;
                 for k in 0..WIDTH {
+                    if node.unused(k) {
+                        continue;
+                    }
                     let (hit, _) = pb.hits(node, k, live, &limit);
                     if hit == 0 {
                         continue;

@@ -126,41 +126,51 @@ impl SceneGeometry {
         if lanes == 0 {
             return best;
         }
-        let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
         let mut t_max = lane_rays.t_max;
         let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
-        self.bvh
-            .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
-                if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
-                    let (hit, t) = lane_rays.sphere(s, lanes, t_max);
-                    for i in lanes_of(hit) {
-                        t_max[i] = t[i];
+        let mut test = |slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]| -> Lanes {
+            if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
+                let (hit, t) = lane_rays.sphere(s, lanes, t_max);
+                for i in lanes_of(hit) {
+                    t_max[i] = t[i];
+                    best[i] = Some(PacketHit {
+                        slot: slot as u32,
+                        hit: PrimHit {
+                            t: t[i],
+                            local: Vec2::ZERO,
+                        },
+                    });
+                }
+                return hit;
+            }
+            let mut found = 0;
+            for i in lanes_of(lanes) {
+                let Some(ray) = &rays[i] else { continue };
+                if let Some(h) = self.test_prim(slot, ray, &mut tri[i], t_max[i]) {
+                    if h.t <= t_max[i] {
+                        t_max[i] = h.t;
                         best[i] = Some(PacketHit {
                             slot: slot as u32,
-                            hit: PrimHit {
-                                t: t[i],
-                                local: Vec2::ZERO,
-                            },
+                            hit: h,
                         });
-                    }
-                    return hit;
-                }
-                let mut found = 0;
-                for i in lanes_of(lanes) {
-                    let Some(ray) = &rays[i] else { continue };
-                    if let Some(h) = self.test_prim(slot, ray, &mut tri[i], t_max[i]) {
-                        if h.t <= t_max[i] {
-                            t_max[i] = h.t;
-                            best[i] = Some(PacketHit {
-                                slot: slot as u32,
-                                hit: h,
-                            });
-                            found |= 1 << i;
-                        }
+                        found |= 1 << i;
                     }
                 }
-                found
-            });
+            }
+            found
+        };
+        match self.bvh.single_leaf() {
+            // A scene of a few primitives: no box to test.
+            Some(slots) => {
+                for slot in slots {
+                    test(slot, lanes, &mut t_max);
+                }
+            }
+            None => {
+                let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
+                self.bvh.closest_hit_packet(&pb, lanes, &mut t_max, test);
+            }
+        }
         best
     }
 
@@ -187,10 +197,9 @@ impl SceneGeometry {
         if lanes == 0 {
             return 0;
         }
-        let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
         let t_max = lane_rays.t_max;
         let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
-        self.bvh.any_hit_packet(&pb, lanes, &t_max, |slot, lanes| {
+        let mut test = |slot: usize, lanes: Lanes| -> Lanes {
             if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
                 return lane_rays.sphere(s, lanes, &t_max).0;
             }
@@ -200,7 +209,23 @@ impl SceneGeometry {
                     .is_some_and(|ray| self.test_prim(slot, ray, &mut tri[i], t_max[i]).is_some());
                 hit | ((occluded as Lanes) << i)
             })
-        })
+        };
+        match self.bvh.single_leaf() {
+            Some(slots) => {
+                let mut left = lanes;
+                for slot in slots {
+                    if left == 0 {
+                        break;
+                    }
+                    left &= !test(slot, left);
+                }
+                lanes & !left
+            }
+            None => {
+                let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
+                self.bvh.any_hit_packet(&pb, lanes, &t_max, test)
+            }
+        }
     }
 }
 
@@ -215,6 +240,16 @@ mod tests {
     /// Every kind of primitive: a floor, two spheres (one inside the other's box), a disk
     /// lamp, and a 2,000-triangle torus knot (a BVH of many nodes).
     fn scene() -> SceneGeometry {
+        let mut shapes = small_scene_shapes();
+        let knot = TorusKnot::with_triangles(2000)
+            .mesh(&Transform::translate(Vec3::new(3.0, 0.0, 1.5)).unwrap())
+            .unwrap();
+        shapes.push(knot.into());
+        SceneGeometry::new(shapes).unwrap()
+    }
+
+    /// Four primitives: one leaf.
+    fn small_scene_shapes() -> Vec<Shape> {
         let floor = Rectangle::new(
             &Transform::scale(Vec3::new(10.0, 10.0, 1.0)).unwrap(),
             false,
@@ -228,17 +263,7 @@ mod tests {
             false,
         )
         .unwrap();
-        let knot = TorusKnot::with_triangles(2000)
-            .mesh(&Transform::translate(Vec3::new(3.0, 0.0, 1.5)).unwrap())
-            .unwrap();
-        SceneGeometry::new(vec![
-            floor.into(),
-            ball.into(),
-            far_ball.into(),
-            lamp.into(),
-            knot.into(),
-        ])
-        .unwrap()
+        vec![floor.into(), ball.into(), far_ball.into(), lamp.into()]
     }
 
     /// Rays of three kinds: from a camera (coherent), from random points in random
@@ -293,11 +318,29 @@ mod tests {
         assert!(!geometry.packet_traversal());
         for packet_traversal in [true, false] {
             geometry.packet_traversal = packet_traversal;
-            compare_with_one_ray_queries(&geometry);
+            let (hits, occluded) = compare_with_one_ray_queries(&geometry);
+            // Enough of each outcome for the comparison to mean something.
+            assert!(
+                hits > 6000 && occluded > 6000,
+                "{hits} hits, {occluded} occluded"
+            );
         }
+        // A hierarchy of one leaf is not traversed at all: two nested spheres.
+        let inner = Sphere::new(Vec3::new(0.2, 0.0, 1.0), 0.4).unwrap();
+        let mut shapes = small_scene_shapes();
+        shapes.truncate(2);
+        shapes[0] = inner.into();
+        let small = SceneGeometry::new(shapes).unwrap();
+        assert_eq!(small.bvh.single_leaf(), Some(0..2));
+        let (hits, occluded) = compare_with_one_ray_queries(&small);
+        assert!(
+            hits > 1000 && occluded > 1000,
+            "{hits} hits, {occluded} occluded"
+        );
     }
 
-    fn compare_with_one_ray_queries(geometry: &SceneGeometry) {
+    /// The lanes that hit something and the occluded lanes.
+    fn compare_with_one_ray_queries(geometry: &SceneGeometry) -> (usize, usize) {
         let (mut hits, mut occluded) = (0, 0);
         for rays in packets(geometry, 3000) {
             let packet = geometry.intersect_packet(&rays);
@@ -322,10 +365,6 @@ mod tests {
                 occluded += one as usize;
             }
         }
-        // Enough of each outcome for the comparison to mean something.
-        assert!(
-            hits > 6000 && occluded > 6000,
-            "{hits} hits, {occluded} occluded"
-        );
+        (hits, occluded)
     }
 }
