@@ -86,6 +86,79 @@ impl LaneRays {
     }
 }
 
+/// A closest-hit query in progress: the hit of each lane so far. Its primitive test is a
+/// method forced inline so that it is compiled into the kernel's AVX2 instantiation.
+struct Closest<'a> {
+    geometry: &'a SceneGeometry,
+    rays: &'a [Option<Ray>; PACKET],
+    lane_rays: &'a LaneRays,
+    best: [Option<PacketHit>; PACKET],
+    tri: [Option<TriangleRay>; PACKET],
+}
+
+impl Closest<'_> {
+    /// Tests the primitive in `slot` for `lanes` within `(0, t_max[i]]`; lowers `t_max`
+    /// where it hits and returns those lanes.
+    #[inline(always)]
+    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]) -> Lanes {
+        let g = self.geometry;
+        if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
+            let (hit, t) = self.lane_rays.sphere(s, lanes, t_max);
+            for i in lanes_of(hit) {
+                t_max[i] = t[i];
+                self.best[i] = Some(PacketHit {
+                    slot: slot as u32,
+                    hit: PrimHit {
+                        t: t[i],
+                        local: Vec2::ZERO,
+                    },
+                });
+            }
+            return hit;
+        }
+        let mut found = 0;
+        for i in lanes_of(lanes) {
+            let Some(ray) = &self.rays[i] else { continue };
+            if let Some(h) = g.test_prim(slot, ray, &mut self.tri[i], t_max[i]) {
+                if h.t <= t_max[i] {
+                    t_max[i] = h.t;
+                    self.best[i] = Some(PacketHit {
+                        slot: slot as u32,
+                        hit: h,
+                    });
+                    found |= 1 << i;
+                }
+            }
+        }
+        found
+    }
+}
+
+/// An occlusion query in progress (see [`Closest`]).
+struct Occluded<'a> {
+    geometry: &'a SceneGeometry,
+    rays: &'a [Option<Ray>; PACKET],
+    lane_rays: &'a LaneRays,
+    tri: [Option<TriangleRay>; PACKET],
+}
+
+impl Occluded<'_> {
+    /// The lanes of `lanes` whose ray hits the primitive in `slot` within `t_max`.
+    #[inline(always)]
+    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &[f64; PACKET]) -> Lanes {
+        let g = self.geometry;
+        if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
+            return self.lane_rays.sphere(s, lanes, t_max).0;
+        }
+        lanes_of(lanes).fold(0, |hit, i| {
+            let occluded = self.rays[i]
+                .as_ref()
+                .is_some_and(|ray| g.test_prim(slot, ray, &mut self.tri[i], t_max[i]).is_some());
+            hit | ((occluded as Lanes) << i)
+        })
+    }
+}
+
 /// The largest hierarchy (in wide nodes) traversed by packets; larger ones are traversed
 /// one lane at a time. On the 1M-triangle mesh scene (`scenes/mesh.toml`), whose
 /// secondary rays scatter over the mesh, packet traversal rendered at 0.75–0.8× the speed
@@ -127,51 +200,29 @@ impl SceneGeometry {
             return best;
         }
         let mut t_max = lane_rays.t_max;
-        let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
-        let mut test = |slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]| -> Lanes {
-            if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
-                let (hit, t) = lane_rays.sphere(s, lanes, t_max);
-                for i in lanes_of(hit) {
-                    t_max[i] = t[i];
-                    best[i] = Some(PacketHit {
-                        slot: slot as u32,
-                        hit: PrimHit {
-                            t: t[i],
-                            local: Vec2::ZERO,
-                        },
-                    });
-                }
-                return hit;
-            }
-            let mut found = 0;
-            for i in lanes_of(lanes) {
-                let Some(ray) = &rays[i] else { continue };
-                if let Some(h) = self.test_prim(slot, ray, &mut tri[i], t_max[i]) {
-                    if h.t <= t_max[i] {
-                        t_max[i] = h.t;
-                        best[i] = Some(PacketHit {
-                            slot: slot as u32,
-                            hit: h,
-                        });
-                        found |= 1 << i;
-                    }
-                }
-            }
-            found
+        let mut q = Closest {
+            geometry: self,
+            rays,
+            lane_rays: &lane_rays,
+            best,
+            tri: [None; PACKET],
         };
         match self.bvh.single_leaf() {
             // A scene of a few primitives: no box to test.
             Some(slots) => {
                 for slot in slots {
-                    test(slot, lanes, &mut t_max);
+                    q.test(slot, lanes, &mut t_max);
                 }
             }
             None => {
                 let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
-                self.bvh.closest_hit_packet(&pb, lanes, &mut t_max, test);
+                self.bvh
+                    .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
+                        q.test(slot, lanes, t_max)
+                    });
             }
         }
-        best
+        q.best
     }
 
     /// The surface record of `ray`'s hit `hit` found by
@@ -198,18 +249,13 @@ impl SceneGeometry {
             return 0;
         }
         let t_max = lane_rays.t_max;
-        let mut tri: [Option<TriangleRay>; PACKET] = [None; PACKET];
-        let mut test = |slot: usize, lanes: Lanes| -> Lanes {
-            if let Shape::Sphere(s) = &self.shapes[self.prims[slot].shape as usize] {
-                return lane_rays.sphere(s, lanes, &t_max).0;
-            }
-            lanes_of(lanes).fold(0, |hit, i| {
-                let occluded = rays[i]
-                    .as_ref()
-                    .is_some_and(|ray| self.test_prim(slot, ray, &mut tri[i], t_max[i]).is_some());
-                hit | ((occluded as Lanes) << i)
-            })
+        let mut q = Occluded {
+            geometry: self,
+            rays,
+            lane_rays: &lane_rays,
+            tri: [None; PACKET],
         };
+        let mut test = |slot, lanes| q.test(slot, lanes, &t_max);
         match self.bvh.single_leaf() {
             Some(slots) => {
                 let mut left = lanes;
