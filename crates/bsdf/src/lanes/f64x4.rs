@@ -43,7 +43,9 @@ mod tests {
     fn lanes_compute_what_f64_computes_bit_for_bit() {
         let a = F64x4([0.3, -2.5, 1e-300, f64::INFINITY]);
         let b = F64x4([7.0, 0.1, 3.0, 2.0]);
-        let ops: [(fn(F64x4, F64x4) -> F64x4, fn(f64, f64) -> f64); 4] = [
+        type LaneOp = fn(F64x4, F64x4) -> F64x4;
+        type ScalarOp = fn(f64, f64) -> f64;
+        let ops: [(LaneOp, ScalarOp); 4] = [
             (|x, y| x + y, |x, y| x + y),
             (|x, y| x - y, |x, y| x - y),
             (|x, y| x * y, |x, y| x * y),
