@@ -42,13 +42,22 @@ use crate::models::rough_dielectric::RoughDielectric;
 
 /// Dielectric facets between the outside (index 1) and the inside (index η).
 #[derive(Clone, Debug)]
-struct DielectricFacets {
+pub(super) struct DielectricFacets {
     eta: f64,
     reflect_tint: Spectrum,
     transmit_tint: Spectrum,
 }
 
 impl DielectricFacets {
+    /// Untinted facets of relative index η (every event weight 1).
+    pub(super) fn white(eta: f64) -> Self {
+        DielectricFacets {
+            eta,
+            reflect_tint: Spectrum::ONE,
+            transmit_tint: Spectrum::ONE,
+        }
+    }
+
     /// (index of the medium the light is in, index of the other).
     #[inline]
     fn indices(&self, inside: bool) -> (f64, f64) {
