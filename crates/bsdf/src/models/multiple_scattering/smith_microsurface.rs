@@ -371,8 +371,8 @@ impl Microsurface {
     /// direction's side (from the second vertex on: first-vertex escapes are the single
     /// scattering) and the walk continues, with the remaining probability, to a next
     /// intersection drawn conditioned on a hit (Russian roulette once under 1/20 of the
-    /// entering flux). Fresnel's choice at each facet stays sampled. `None` when a
-    /// degenerate configuration stops the walk.
+    /// entering flux). Fresnel's choice at each facet stays sampled. `None` for a direction
+    /// in the tangent plane.
     pub fn higher_order_exits(
         &self,
         facets: &impl FacetScattering,
@@ -418,7 +418,11 @@ impl Microsurface {
                 Some(n) => h = n,
                 None => break,
             }
-            let (out, crossed, _) = self.scatter(facets, -d, inside, rng)?;
+            // A degenerate facet event ends the walk, as in `walk`: the flux still in the
+            // microsurface is lost, what escaped before stays tallied.
+            let Some((out, crossed, _)) = self.scatter(facets, -d, inside, rng) else {
+                break;
+            };
             dir = to_side(out, inside);
             if crossed {
                 inside = !inside;
