@@ -339,6 +339,9 @@ pub fn material_grid() -> Vec<&'static str> {
         r#"{type = "dielectric", distribution = "ggx", alpha = 0.02, ior = 1.33}"#,
         r#"{type = "dielectric", distribution = "ggx", alpha = 0.1}"#,
         r#"{type = "dielectric", distribution = "ggx", alpha = 0.3, masking = "smith-correlated"}"#,
+        // Issue 18's grazing case: GGX glass α = 0.7, checked like every entry at 85° from
+        // both sides.
+        r#"{type = "dielectric", distribution = "ggx", alpha = 0.7}"#,
         r#"{type = "dielectric", distribution = "ggx", alpha = 1.0, sampling = "distribution"}"#,
         r#"{type = "dielectric", distribution = "ggx", alpha_u = 0.05, alpha_v = 0.4}"#,
         r#"{type = "dielectric", preset = "ground", distribution = "ggx"}"#,

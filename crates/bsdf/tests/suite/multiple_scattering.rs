@@ -163,29 +163,34 @@ fn dielectric_reflectance_plus_transmittance_is_one_from_both_sides() {
     );
     assert!(worst_walk < 1e-4, "{worst_walk}");
     assert!(worst_comp < 5e-3, "{worst_comp}");
-    // The split is a model, not the walk: measured 0.13 at GGX α = 1.5 (it was 0.42 at 85°
-    // from outside before the split followed the caught light; docs/materials.md), bounded.
-    // Beckmann α ≤ 1 and GGX α ≤ 0.3 are held to 2 % in the test below.
-    assert!(worst_split < 0.15, "{worst_split}");
+    // The split is tabulated from the walk (docs/materials.md): R within 2 % of the walk's
+    // here too (it was 0.13 at GGX α = 1.5 with the former Markov-chain split, 0.42 before).
+    assert!(worst_split < 0.02, "{worst_split}");
 }
 
 #[test]
 fn compensated_glass_splits_reflection_and_transmission_like_the_walk() {
     // R and T of `energy = "compensated"` each within 2 % (absolute) of the random walk's
-    // (`scattering = "multiple"`), at 0, 45, 70 and 85° from both sides, η = 1.5: flux
-    // (importance mode). Measured figures in docs/materials.md.
-    let mut worst: (f64, String) = (0.0, String::new());
-    for (dist, alphas) in [
-        ("beckmann", &[0.1, 0.3, 0.5, 0.7, 1.0][..]),
-        ("ggx", &[0.1, 0.3][..]),
-    ] {
-        for &alpha in alphas {
+    // (`scattering = "multiple"`), at 0, 45, 70 and 85° from both sides, η = 1.5, Beckmann
+    // and GGX α from 0.1 to 1.5: flux (importance mode). Walk 40 000 samples, compensated
+    // model 80 000 (standard error of a difference ≤ 3.5e-3). Measured figures (and α = 3,
+    // 10) in docs/materials.md: largest 0.009 since the split is tabulated from the walk;
+    // 0.131 (GGX α = 1.5) with the former Markov-chain split.
+    let alphas = [0.1, 0.3, 0.5, 0.7, 1.0, 1.5];
+    let cases: Vec<(&str, f64)> = ["beckmann", "ggx"]
+        .iter()
+        .flat_map(|&d| alphas.iter().map(move |&a| (d, a)))
+        .collect();
+    let rows: Vec<Vec<(f64, String)>> = cases
+        .par_iter()
+        .map(|&(dist, alpha)| {
             let ms = material(&format!(
                 r#"{{type = "dielectric", distribution = "{dist}", alpha = {alpha}, ior = 1.5, scattering = "multiple"}}"#
             ));
             let comp = material(&format!(
                 r#"{{type = "dielectric", distribution = "{dist}", alpha = {alpha}, ior = 1.5, masking = "smith-correlated", energy = "compensated"}}"#
             ));
+            let mut out = Vec::new();
             for (k, deg) in [0.0f64, 45.0, 70.0, 85.0].iter().enumerate() {
                 for side in [1.0, -1.0] {
                     let w = spherical_direction(deg.to_radians(), 0.4);
@@ -193,23 +198,29 @@ fn compensated_glass_splits_reflection_and_transmission_like_the_walk() {
                     let ctx = BsdfContext::IMPORTANCE;
                     let seed = 4000 + 16 * k as u64 + (side < 0.0) as u64;
                     let walk = sampled(ms.as_ref(), wo, &ctx, 40_000, seed);
-                    let c = sampled(comp.as_ref(), wo, &ctx, 80_000, seed);
+                    let c = sampled(comp.as_ref(), wo, &ctx, 80_000, seed + 8);
                     let (dr, dt) = (c[0] - walk[0], c[2] - walk[2]);
-                    let label = format!(
-                        "{dist} α = {alpha} θ = {deg}° {}: walk R {:.4} T {:.4}, compensated R {:.4} T {:.4} (ΔR {dr:+.4}, ΔT {dt:+.4})",
-                        if side > 0.0 { "outside" } else { "inside " },
-                        walk[0],
-                        walk[2],
-                        c[0],
-                        c[2]
-                    );
-                    println!("{label}");
-                    let d = dr.abs().max(dt.abs());
-                    if d > worst.0 {
-                        worst = (d, label);
-                    }
+                    out.push((
+                        dr.abs().max(dt.abs()),
+                        format!(
+                            "{dist} α = {alpha} θ = {deg}° {}: walk R {:.4} T {:.4}, compensated R {:.4} T {:.4} (ΔR {dr:+.4}, ΔT {dt:+.4})",
+                            if side > 0.0 { "outside" } else { "inside " },
+                            walk[0],
+                            walk[2],
+                            c[0],
+                            c[2]
+                        ),
+                    ));
                 }
             }
+            out
+        })
+        .collect();
+    let mut worst: (f64, String) = (0.0, String::new());
+    for (d, label) in rows.into_iter().flatten() {
+        println!("{label}");
+        if d > worst.0 {
+            worst = (d, label);
         }
     }
     println!("largest |ΔR| or |ΔT|: {:.4} ({})", worst.0, worst.1);
@@ -312,6 +323,8 @@ fn the_walks_eval_agrees_with_its_samples() {
         (glass, grazing(1.0), BsdfContext::RADIANCE, 1.0),
         (glass, grazing(1.0), BsdfContext::RADIANCE, -1.0),
         (rough, grazing(-1.0), BsdfContext::IMPORTANCE, -1.0),
+        (rough, grazing(-1.0), BsdfContext::IMPORTANCE, 1.0),
+        (rough, grazing(1.0), BsdfContext::IMPORTANCE, 1.0),
         (rough, grazing(1.0), BsdfContext::IMPORTANCE, -1.0),
     ]);
     for (k, (toml, wo, ctx, region)) in cases.into_iter().enumerate() {

@@ -20,35 +20,39 @@
 //! η² (1 − r_i) = 1 − r_e of a flat interface (IL18 eq. 11), here required of the
 //! compensation's average transmittances [KC17 §5's reciprocity constraint].
 //!
-//! **The split s_A(μ)** [KC17 §5: the ratio of the reflectance and transmittance from both
-//! sides]. The first facet the light meets (a visible normal, WMLT07 eq. 41's sampler)
-//! reflects or refracts it with Fresnel's F; the scattered ray leaves with the probability
-//! G/G1 (R_A(μ) and T_A(μ) in all, E_A = R_A + T_A) or is caught by the microsurface, on
-//! side A if reflected, on the other side if refracted, and meets it again. The split
-//! follows the caught light as a Markov chain on the states (side, μ): light caught
-//! travelling with |cos θ| = μ′ is taken to meet the surface as light from μ′ on that side —
-//! leaving with R and T of that state or caught again, with the same first-hit statistics
-//! (`first_hit`: a 64 × 64 midpoint grid over the visible-normal square per state, the
-//! caught mass deposited on the μ nodes). Solving (I − K) x = b over the 2 × 33 states for
-//! x, the probability of ending outside, gives the energy of orders ≥ 2 that leaves on the
-//! light's own side, a_A(μ) = Σ caught(μ → state) x_A(state), and s_A = a_A / (1 − E_A)
-//! with the first-hit 1 − R − T. The chain uses the average behaviour of each (side, μ)
-//! only, so the shares of both sides come from the reflectances and transmittances of
-//! both. Finally the transmittances are scaled, u_A → min(1 − E_A, K_A u_A), with K_A such
-//! that ū_out and η² ū_in both become their geometric mean √(ū_out η² ū_in) (the
-//! reciprocity constraint; K by bisection). s_A is tabulated on 33 values of μ
-//! (μ_k = (k/32)², linear in between) at the 40 rows of the albedo tables' α axis (built
-//! on first use, about 0.07 s of CPU a row, cached per distribution kind, masking and η, so that
-//! textured roughness rebuilds a material with lookups only) and interpolated linearly in α
-//! like E; ū at the material's α is the exact average of the product of the two
-//! interpolants (a quadratic in the row fraction, its coefficients integrated per pair of
-//! rows by a 1024-point midpoint rule), and between rows the side whose ū exceeds the
-//! reciprocity relation scales its u by the factor ≤ 1 that restores it. The lobes thus
-//! restore the energy they should and stay reciprocal at every α. The tints multiply the lobes of their kind (`specular_reflectance` the reflection
-//! lobes, `specular_transmittance` the transmission lobes). The split is a model, measured
-//! against the random walk's reflectance and transmittance in `tests/multiple_scattering.rs`
-//! and `docs/materials.md`: within 2 % absolute at 0–85° from both sides for Beckmann
-//! α ≤ 1 and GGX α ≤ 0.3 (η = 1.5); up to 0.13 off for GGX α = 1.5 (before: 0.42).
+//! **The split s_A(μ)** [KC17 §5 split the compensation by the ratio of the average
+//! reflectance and transmittance from both sides; here the split is measured, per incidence,
+//! on the random walk of `scattering = "multiple"`, HHdD16 §5]. For light from μ on side A,
+//! s_A(μ) is the fraction of the walk's orders ≥ 2 that leave on side A: the walk's first
+//! order is the single-scattering lobe with height-correlated masking, and the walk loses no
+//! energy, so with that masking R_ss + s_A (1 − E_A) is the walk's reflectance (and the
+//! rest its transmittance) up to the table's noise and interpolation. It is estimated by
+//! [`SHARE_WALKS`] walks per side and node with expected escapes
+//! ([`Microsurface::higher_order_exits`]: each vertex tallies the probability G1(w, h) =
+//! C1(h)^Λ(w) that the scattered ray escapes instead of sampling it), from fixed seeds per
+//! (row, side, node), so the table is deterministic whatever the thread count. Finally
+//! the transmittances are scaled, u_A → min(1 − E_A, K_A u_A), with K_A such that ū_out
+//! and η² ū_in both become their geometric mean √(ū_out η² ū_in) (the reciprocity
+//! constraint, which the walk satisfies in expectation: the scaling only removes its
+//! noise and, with `masking = "smith"`, the difference between the two maskings' 1 − E;
+//! K by bisection). s_A is tabulated on 33 values of μ (μ_k = (k/32)², linear in between;
+//! node 0 walked at μ_1/4) at the 40 rows of the albedo tables' α axis (built on first use:
+//! 2 × 33 × 4096 walks a row, measured 0.10–0.29 s of CPU a row for α ≤ 1.5, 0.45 s at
+//! α = 3, 0.83 s at α ≈ 10, against 0.07 s for the former Markov-chain model — on one
+//! thread; rows are walked in parallel; cached per distribution kind, masking
+//! and η, so that textured roughness rebuilds a material with lookups only) and
+//! interpolated linearly in α like E; ū at the material's α is the exact average of the
+//! product of the two interpolants (a quadratic in the row fraction, its coefficients
+//! integrated per pair of rows by a 1024-point midpoint rule), and between rows the side
+//! whose ū exceeds the reciprocity relation scales its u by the factor ≤ 1 that restores
+//! it. The lobes thus restore the energy they should and stay reciprocal at every α. The
+//! tints multiply the lobes of their kind (`specular_reflectance` the reflection lobes,
+//! `specular_transmittance` the transmission lobes). Measured against the random walk's
+//! reflectance and transmittance (`tests/suite/multiple_scattering.rs`, `docs/materials.md`,
+//! η = 1.5, `masking = "smith-correlated"`): R and T each within 0.01 absolute at θ ∈ {0,
+//! 45, 70, 85}° from both sides for Beckmann and GGX α ∈ {0.1, 0.3, 0.5, 0.7, 1, 1.5, 3,
+//! 10} (the Markov chain that followed the first facet's caught light before was up to
+//! 0.13 off, GGX α = 1.5).
 //!
 //! **Sampling.** With probability E_A(μ_o) for the view's side A, WMLT07's sampler; otherwise
 //! reflection with probability s_A(μ_o) or transmission, with μ drawn from the density
@@ -57,25 +61,28 @@
 //! eval·|cos|/pdf.
 
 use super::albedo_tables::{
-    isotropic_lobe, kind_of_table, row_alpha, row_weight, table_alpha, AlbedoTable, TableFresnel,
-    ALPHA_NODES,
+    kind_of_table, row_alpha, row_weight, table_alpha, AlbedoTable, TableFresnel, ALPHA_NODES,
 };
+use super::multiple_scattering_dielectric::DielectricFacets;
+use super::smith_microsurface::{HeightDistribution, Microsurface};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample, LobeFlags, TransportMode};
 use crate::error::{ParamError, ParamResult};
 use crate::finite::guard;
-use crate::fresnel::fresnel_dielectric;
-use crate::math::rng::RandomSource;
+use crate::math::rng::{mix_seed, Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
-use crate::math::{reflect, refract, Vec2, Vec3, INV_PI, TWO_PI};
-use crate::microfacet::{Distribution, Masking, Ndf};
+use crate::math::{Vec3, INV_PI, TWO_PI};
+use crate::microfacet::{Beckmann, BeckmannG1, Ggx, Masking, Ndf};
 use crate::models::rough_dielectric::RoughDielectric;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Nodes of the share tables: μ_k = (k/(N − 1))², dense at grazing incidence.
 const SHARE_NODES: usize = 33;
-/// Midpoint grid (per dimension) of the first-hit integrals over the visible-normal square.
-const FIRST_HIT_GRID: usize = 64;
+/// Walks per node and side that measure the shares.
+const SHARE_WALKS: usize = 4096;
+/// Seed of the share tables' walks (mixed with the row, side and node).
+const SHARE_SEED: u64 = 0x5eed_5a4e;
 /// Midpoints of the rule that averages the lobes over μ.
 const AVERAGE_POINTS: usize = 1024;
 
@@ -132,7 +139,6 @@ pub struct CompensatedDielectric {
 #[derive(Debug)]
 struct ShareRows {
     ndf: Ndf,
-    masking: Masking,
     eta: f64,
     rows: Vec<OnceLock<Arc<Shares>>>,
     pairs: Vec<OnceLock<[[f64; 3]; 2]>>,
@@ -153,7 +159,6 @@ impl ShareRows {
             .or_insert_with(|| {
                 Arc::new(ShareRows {
                     ndf: ndf.clone(),
-                    masking,
                     eta,
                     rows: (0..ALPHA_NODES).map(|_| OnceLock::new()).collect(),
                     pairs: (0..ALPHA_NODES).map(|_| OnceLock::new()).collect(),
@@ -162,13 +167,13 @@ impl ShareRows {
             .clone())
     }
 
-    /// The shares at row j: the chain's split at α_j with ū_out = η² ū_in imposed there.
+    /// The shares at row j: the walk's split at α_j with ū_out = η² ū_in imposed there.
     fn row(&self, j: usize, out_t: &AlbedoTable, in_t: &AlbedoTable) -> Arc<Shares> {
         self.rows[j]
             .get_or_init(|| {
                 let alpha = row_alpha(j);
                 let eta = self.eta;
-                let mut s = raw_shares(&self.ndf, alpha, self.masking, eta);
+                let mut s = walk_shares(&self.ndf, j, eta);
                 let cur_out = averages(out_t, alpha, &s.outside);
                 let cur_in = averages(in_t, alpha, &s.inside);
                 let target = (cur_out.1 * eta * eta * cur_in.1).sqrt();
@@ -212,177 +217,69 @@ impl ShareRows {
     }
 }
 
-/// Deposits `mass` at μ on the share nodes (linear weights between the two around it).
-#[inline]
-fn deposit(bins: &mut [f64; SHARE_NODES], mu: f64, mass: f64) {
-    let mu = mu.clamp(0.0, 1.0);
-    let x = mu.sqrt() * (SHARE_NODES - 1) as f64;
-    let k = (x as usize).min(SHARE_NODES - 2);
-    let (p, q) = (share_node(k), share_node(k + 1));
-    let t = ((mu - p) / (q - p)).clamp(0.0, 1.0);
-    bins[k] += mass * (1.0 - t);
-    bins[k + 1] += mass * t;
+/// The microsurface of the walk that measures the shares: the isotropic lobe of `ndf`'s
+/// kind at width α, Beckmann with the exact Λ (the walk's free paths are defined by Λ,
+/// HHdD16 §4, whatever G1 form the material's single scattering uses).
+fn walk_surface(ndf: &Ndf, alpha: f64) -> Option<Microsurface> {
+    let lobe = match ndf {
+        Ndf::Beckmann(_) => Ndf::Beckmann(
+            Beckmann::isotropic(1.0)
+                .ok()?
+                .with_g1(BeckmannG1::Exact)
+                .scaled(alpha),
+        ),
+        Ndf::Ggx(_) => Ndf::Ggx(Ggx::isotropic(1.0).ok()?.scaled(alpha)),
+        _ => return None,
+    };
+    Microsurface::new(lobe, HeightDistribution::Uniform).ok()
 }
 
-/// The cosine at which caught light meets the surface again, for a scattered direction
-/// whose z in the frame of the side it travels in is `z`: |z| (a ray going into the surface
-/// meets it as light from that cosine; one going away and caught nonetheless is given the
-/// same — taking it as grazing instead was measured worse: 24 of 96 (material, angle,
-/// side) cases off by more than 2 % instead of 25, but up to 0.19 instead of 0.13).
-#[inline]
-fn blocked_mu(z: f64) -> f64 {
-    z.abs()
-}
-
-/// What the first facet does to light from cos θ = μ on the side whose far-side relative
-/// index is `eta`: (R, T, caught on the own side by the cosine of its direction, caught on
-/// the other side likewise) — the visible-normal estimator of WMLT07 eq. 41 with G/G1 the
-/// escape probability of the scattered ray, integrated on a midpoint grid of the sampler's
-/// unit square.
-fn first_hit(
-    ndf: &Ndf,
-    masking: Masking,
-    eta: f64,
-    mu: f64,
-) -> (f64, f64, [f64; SHARE_NODES], [f64; SHARE_NODES]) {
-    let mu = mu.clamp(1e-4, 1.0);
-    let o = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-    let mut own = [0.0; SHARE_NODES];
-    let mut other = [0.0; SHARE_NODES];
-    let (mut r_sum, mut t_sum) = (0.0, 0.0);
-    let g1 = 1.0 / (1.0 + ndf.lambda(o));
-    if !(g1 > 0.0) {
-        return (0.0, 0.0, own, other);
-    }
-    let n = FIRST_HIT_GRID;
-    let w = 1.0 / (n * n) as f64;
-    for a in 0..n {
-        for b in 0..n {
-            let u = Vec2::new((a as f64 + 0.5) / n as f64, (b as f64 + 0.5) / n as f64);
-            let m = ndf.sample_visible(o, u);
-            let c = o.dot(m);
-            if !(c > 0.0) {
-                continue;
-            }
-            let f = fresnel_dielectric(c, eta);
-            let i = reflect(o, m);
-            let escape = if i.z > 0.0 {
-                (masking.g(ndf, i, o, m) / g1).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            r_sum += w * f * escape;
-            deposit(&mut own, blocked_mu(i.z), w * f * (1.0 - escape));
-            if f < 1.0 {
-                if let Some(t) = refract(o, m, 1.0 / eta) {
-                    let escape = if t.z < 0.0 {
-                        (masking.g(ndf, t, o, m) / g1).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    t_sum += w * (1.0 - f) * escape;
-                    deposit(&mut other, blocked_mu(-t.z), w * (1.0 - f) * (1.0 - escape));
-                }
-            }
-        }
-    }
-    (r_sum, t_sum, own, other)
-}
-
-/// The split of KC17 §5 as derived in the module header, before the reciprocity
-/// constraint: shares at the nodes for the outside and the inside.
-fn raw_shares(ndf: &Ndf, alpha: f64, masking: Masking, eta: f64) -> Shares {
-    let iso = isotropic_lobe(ndf, alpha.max(1e-4)).unwrap_or_else(|| ndf.clone());
-    // States: (side, node), outside first. Per state: the probabilities to leave outside
-    // at once, and the transitions to caught states.
-    let s = SHARE_NODES;
-    let mut kernel = vec![0.0; 4 * s * s];
-    let mut leave_out = vec![0.0; 2 * s];
-    let mut rows: Vec<([f64; SHARE_NODES], [f64; SHARE_NODES])> = Vec::with_capacity(2 * s);
-    for side in 0..2 {
-        let rel = if side == 0 { eta } else { 1.0 / eta };
-        for k in 0..s {
-            let (r, t, own, oth) = first_hit(&iso, masking, rel, share_node(k));
-            let state = side * s + k;
-            leave_out[state] = if side == 0 { r } else { t };
-            let other_side = 1 - side;
-            for j in 0..s {
-                kernel[state * 2 * s + side * s + j] = own[j];
-                kernel[state * 2 * s + other_side * s + j] = oth[j];
-            }
-            rows.push((own, oth));
-        }
-    }
-    // x = leave_out + K x: the probability that light in each state ends up outside.
-    let dim = 2 * s;
-    let mut m = vec![0.0; dim * dim];
-    let mut x = leave_out.clone();
-    for r in 0..dim {
-        for c in 0..dim {
-            m[r * dim + c] = if r == c { 1.0 } else { 0.0 } - kernel[r * dim + c];
-        }
-    }
-    // Gaussian elimination with partial pivoting (the matrix is diagonally dominant when
-    // light leaves at every state; a zero pivot leaves that state at ½).
-    for col in 0..dim {
-        let piv = (col..dim)
-            .max_by(|&a, &b| m[a * dim + col].abs().total_cmp(&m[b * dim + col].abs()))
-            .unwrap_or(col);
-        if piv != col {
-            for c in 0..dim {
-                m.swap(col * dim + c, piv * dim + c);
-            }
-            x.swap(col, piv);
-        }
-        let p = m[col * dim + col];
-        if p.abs() < 1e-12 {
-            continue;
-        }
-        for r in 0..dim {
-            if r != col {
-                let f = m[r * dim + col] / p;
-                if f != 0.0 {
-                    for c in col..dim {
-                        m[r * dim + c] -= f * m[col * dim + c];
-                    }
-                    x[r] -= f * x[col];
-                }
-            }
-        }
-    }
-    for r in 0..dim {
-        let p = m[r * dim + r];
-        x[r] = if p.abs() < 1e-12 {
-            0.5
-        } else {
-            (x[r] / p).clamp(0.0, 1.0)
+/// The split of the orders ≥ 2 measured on the random walk [HHdD16 §5, dielectrics]:
+/// per side and node μ_k, s = (flux of orders ≥ 2 leaving on the light's side) / (all flux
+/// of orders ≥ 2), by [`SHARE_WALKS`] walks with expected escapes
+/// ([`Microsurface::higher_order_exits`]), each state from its own fixed seed (the table is
+/// the same whatever the thread count). Row 0 (α = 0, nothing to compensate) takes the
+/// shares of row 1.
+fn walk_shares(ndf: &Ndf, row: usize, eta: f64) -> Shares {
+    let alpha = row_alpha(row.max(1));
+    let Some(surface) = walk_surface(ndf, alpha) else {
+        return Shares {
+            outside: [0.5; SHARE_NODES],
+            inside: [0.5; SHARE_NODES],
         };
-    }
-    // Reflected energy of orders ≥ 2 from incidence at node k of a side: the caught light
-    // times the probability that it ends up on that side.
-    let mut shares = [[0.0; SHARE_NODES]; 2];
-    for side in 0..2 {
-        for k in 0..s {
-            let (own, oth) = &rows[side * s + k];
-            let mut out = 0.0;
-            for j in 0..s {
-                out += own[j] * x[side * s + j] + oth[j] * x[(1 - side) * s + j];
+    };
+    let facets = DielectricFacets::white(eta);
+    let shares: Vec<f64> = (0..2 * SHARE_NODES)
+        .into_par_iter()
+        .map(|state| {
+            let (side, k) = (state / SHARE_NODES, state % SHARE_NODES);
+            // Node 0 (μ = 0) is walked at a quarter of node 1's cosine.
+            let mu = share_node(k).max(0.25 * share_node(1));
+            let z = if side == 0 { mu } else { -mu };
+            let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, z);
+            let seed = mix_seed(SHARE_SEED, (row * 2 * SHARE_NODES + state) as u64);
+            let mut rng = Pcg32::new(seed, eta.to_bits());
+            let (mut own, mut other) = (0.0, 0.0);
+            for _ in 0..SHARE_WALKS {
+                if let Some((a, b)) = surface.higher_order_exits(&facets, wi, &mut rng) {
+                    own += a;
+                    other += b;
+                }
             }
-            let total = own.iter().sum::<f64>() + oth.iter().sum::<f64>();
-            let back = if side == 0 { out } else { total - out };
-            shares[side][k] = if total > 1e-12 {
-                (back / total).clamp(0.0, 1.0)
-            } else if side == 0 {
-                0.0
+            if own + other > 0.0 {
+                own / (own + other)
             } else {
-                1.0
-            };
-        }
-    }
-    Shares {
-        outside: shares[0],
-        inside: shares[1],
-    }
+                0.5
+            }
+        })
+        .collect();
+    let mut out = Shares {
+        outside: [0.0; SHARE_NODES],
+        inside: [0.0; SHARE_NODES],
+    };
+    out.outside.copy_from_slice(&shares[..SHARE_NODES]);
+    out.inside.copy_from_slice(&shares[SHARE_NODES..]);
+    out
 }
 
 /// (ā, ū): 2 ∫ s (1 − E) μ dμ and 2 ∫ (1 − s)(1 − E) μ dμ on the interpolants.

@@ -361,6 +361,77 @@ impl Microsurface {
         None
     }
 
+    /// Where the orders ≥ 2 of light entering from `wi` leave, as expected flux: (leaving
+    /// on the side of `wi`, leaving on the other side) for one walk — an unbiased estimate
+    /// of the walk's reflectance and transmittance of orders ≥ 2 (for facets whose event
+    /// weights are 1, as untinted glass). The physical walk of [`walk`](Self::walk) with
+    /// its escape events replaced by their expectation [HHdD16 §4: the escape probability
+    /// G1(w, h) = C1(h)^Λ(w), eq. of the height of the next intersection]: after each vertex
+    /// the probability of escaping along the scattered direction is tallied on that
+    /// direction's side (from the second vertex on: first-vertex escapes are the single
+    /// scattering) and the walk continues, with the remaining probability, to a next
+    /// intersection drawn conditioned on a hit (Russian roulette once under 1/20 of the
+    /// entering flux). Fresnel's choice at each facet stays sampled. `None` for a direction
+    /// in the tangent plane.
+    pub fn higher_order_exits(
+        &self,
+        facets: &impl FacetScattering,
+        wi: Vec3,
+        rng: &mut dyn RandomSource,
+    ) -> Option<(f64, f64)> {
+        if wi.z == 0.0 {
+            return None;
+        }
+        let start_inside = wi.z < 0.0;
+        let mut inside = start_inside;
+        let mut h = f64::INFINITY;
+        let mut dir = -wi;
+        let mut alive = 1.0;
+        let (mut own, mut other) = (0.0, 0.0);
+        for order in 0..MAX_ORDER {
+            let d = to_side(dir, inside);
+            let u = rng.next_f64();
+            let next = if order == 0 {
+                self.next_height(d, h, u)
+            } else {
+                let e = self.escape_probability(d, h);
+                if order >= 2 {
+                    if inside == start_inside {
+                        own += alive * e;
+                    } else {
+                        other += alive * e;
+                    }
+                }
+                alive *= 1.0 - e;
+                // Russian roulette below 1/20 of the entering flux (unbiased: survivors
+                // carry 1/20), so that walks almost sure to have left stop early.
+                if alive < 0.05 {
+                    if !(rng.next_f64() * 0.05 < alive) {
+                        break;
+                    }
+                    alive = 0.05;
+                }
+                // A hit: u drawn on [0, 1 − e), next_height's range of intersections.
+                self.next_height(d, h, u * (1.0 - e))
+            };
+            match next {
+                Some(n) => h = n,
+                None => break,
+            }
+            // A degenerate facet event ends the walk, as in `walk`: the flux still in the
+            // microsurface is lost, what escaped before stays tallied.
+            let Some((out, crossed, _)) = self.scatter(facets, -d, inside, rng) else {
+                break;
+            };
+            dir = to_side(out, inside);
+            if crossed {
+                inside = !inside;
+                h = -h;
+            }
+        }
+        Some((own, other))
+    }
+
     /// One facet event at the current vertex: a visible normal of `wi`, then the facet's
     /// optics.
     #[inline]
