@@ -27,7 +27,10 @@
 //! **Multiple scattering**  [IL18 §3.3]: `scattering = "double"` (IL₂) or `"multiple"`
 //! (IL_∞) adds the V-cavity inter-reflections of [`super::vcavity`], estimated without bias
 //! by a random walk with next-event estimation (one groove per evaluation); it requires
-//! `masking = "v-cavity"` so that every order uses the same microsurface.
+//! `masking = "v-cavity"` so that every order uses the same microsurface. With
+//! [`InterfacedLambertian::with_multiple_quadrature`] (`multiple_evaluation = "quadrature"`)
+//! `eval` computes the same orders deterministically, purely specular chains included, by
+//! [`super::vcavity_quadrature`]; `sample` keeps the walk.
 //!
 //! Flat IL is `evaluation`-independent (closed form). IL with n_i = 1 is the exact
 //! Oren–Nayar model when the distribution is Gaussian with V-cavity masking.

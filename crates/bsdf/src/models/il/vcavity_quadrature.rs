@@ -70,6 +70,11 @@
 //! W the power that the beam tracer finds on that chain and the Jacobian of the chain's exit
 //! direction (a closed form, differentiated numerically). j = 1 is the single-scattering
 //! lobe [IL18 eq. 4]; IL_2 adds j = 2, IL_∞ every j ≥ 2.
+//! When o is the mirror direction of i (i + o vertical) every azimuth satisfies the axial
+//! condition and the solutions form a curve: the density diverges there, integrably, like
+//! 1/|(i + o)_h| (grooves whose facets meet at the right angle for their azimuth send their
+//! two-bounce chain exactly into the mirror direction); at exactly |(i + o)_h| < 1e-9 the
+//! term is reported as 0.
 //!
 //! **Accuracy.** The groove-orientation integral carries the adaptive rule's error estimate
 //! (tolerance relative to f_ms). Grooves steeper than 90° − ψ_min/2 (ψ_min = 4°, i.e.
@@ -312,10 +317,8 @@ impl ChainTable {
                     let gam = 0.25 * PI * (x + 1.0);
                     let cg = gam.cos();
                     let t = |c: f64| 1.0 - fresnel_dielectric(c, ni);
-                    let mut v = cg
-                        * cg
-                        * t(omega.sin().abs() * cg)
-                        * t((omega - delta).sin().abs() * cg);
+                    let mut v =
+                        cg * cg * t(omega.sin().abs() * cg) * t((omega - delta).sin().abs() * cg);
                     for l in 1..=j {
                         v *= fresnel_dielectric((omega - l as f64 * psi).sin().abs() * cg, ni);
                     }
@@ -405,8 +408,7 @@ fn node_slopes(x: &[f64], f: &[f64]) -> Vec<f64> {
                 (f[k] - f[k - 1]) / (x[k] - x[k - 1])
             } else {
                 let (h0, h1) = (x[k] - x[k - 1], x[k + 1] - x[k]);
-                (h0 * h0 * (f[k + 1] - f[k]) + h1 * h1 * (f[k] - f[k - 1]))
-                    / (h0 * h1 * (h0 + h1))
+                (h0 * h0 * (f[k + 1] - f[k]) + h1 * h1 * (f[k] - f[k - 1])) / (h0 * h1 * (h0 + h1))
             }
         })
         .collect()
@@ -580,8 +582,7 @@ impl GrooveOperator {
                         let mut lhs = vec![0.0; m * m];
                         for r in 0..m {
                             for cc in 0..m {
-                                lhs[r * m + cc] =
-                                    if r == cc { 1.0 } else { 0.0 } - km[r * m + cc];
+                                lhs[r * m + cc] = if r == cc { 1.0 } else { 0.0 } - km[r * m + cc];
                             }
                         }
                         let a = solve_in_place(&mut lhs, km, m);
@@ -608,7 +609,6 @@ impl GrooveOperator {
             tables,
         }
     }
-
 }
 
 /// Solves lhs X = rhs (m × m, row-major, m right-hand sides) by Gaussian elimination with
@@ -899,47 +899,52 @@ impl VCavityQuadrature {
         let channels = if self.grey() { 1 } else { CHANNELS };
         // Fixed first segments (θ nodes then repeat across pairs and hit the cache).
         let breaks = [0.125 * PI, 0.25 * PI, 0.375 * PI];
-        let tol = Tolerance {
-            rel: self.tolerance,
-            abs: 1e-12,
-            max_segments: 200,
-        };
         let mut scratch = Scratch::default();
         let mut evaluations = 0;
         let mut converged = true;
         let dirac = self.specular_chains(i, o, &mut scratch);
         for ch in 0..channels {
             let mut current: Option<(u64, Arc<GrooveOperator>)> = None;
-            let q = integrate_2d(
-                0.0,
-                self.theta_max,
-                &breaks,
-                tol,
-                |theta| InnerRange {
-                    lo: 0.0,
-                    hi: PI,
-                    breaks: azimuth_breaks(theta, i, o),
-                },
-                |theta, phi| {
-                    let key = theta.to_bits();
-                    let op = match &current {
-                        Some((k, op)) if *k == key => op.clone(),
-                        _ => {
-                            let op = self.operator(theta);
-                            current = Some((key, op.clone()));
-                            op
+            let mut run = |tol: Tolerance, scratch: &mut Scratch| {
+                integrate_2d(
+                    0.0,
+                    self.theta_max,
+                    &breaks,
+                    tol,
+                    |theta| InnerRange {
+                        lo: 0.0,
+                        hi: PI,
+                        breaks: azimuth_breaks(theta, i, o),
+                    },
+                    |theta, phi| {
+                        let key = theta.to_bits();
+                        let op = match &current {
+                            Some((k, op)) if *k == key => op.clone(),
+                            _ => {
+                                let op = self.operator(theta);
+                                current = Some((key, op.clone()));
+                                op
+                            }
+                        };
+                        let (st, ct) = theta.sin_cos();
+                        let m = Vec3::new(st * phi.cos(), st * phi.sin(), ct);
+                        let w = 2.0 * self.ndf.d(m) * ct * st;
+                        if !(w > 0.0) {
+                            return 0.0;
                         }
-                    };
-                    let (st, ct) = theta.sin_cos();
-                    let m = Vec3::new(st * phi.cos(), st * phi.sin(), ct);
-                    let w = 2.0 * self.ndf.d(m) * ct * st;
-                    if !(w > 0.0) {
-                        return 0.0;
-                    }
-                    let mut out = [0.0; CHANNELS];
-                    self.groove_density(&op, i, o, phi, &mut scratch, &mut out);
-                    w * out[ch]
+                        let mut out = [0.0; CHANNELS];
+                        self.groove_density(&op, i, o, phi, scratch, &mut out);
+                        w * out[ch]
+                    },
+                )
+            };
+            let q = run(
+                Tolerance {
+                    rel: self.tolerance,
+                    abs: 1e-12,
+                    max_segments: 200,
                 },
+                &mut scratch,
             );
             evaluations += q.evaluations;
             converged &= q.converged;
@@ -1051,27 +1056,45 @@ fn chain_jacobian(i: Vec3, theta: f64, phi: f64, sgn: f64, c: f64, e: f64) -> f6
     dt.cross(dp).length()
 }
 
-/// Azimuths (in [0, π)) where i or o grazes a facet of the groove θ: the footprints change
-/// shape there.
+/// Azimuths (in [0, π)) where the groove density has a kink: where the beam from i or o
+/// changes shape. In the unfolded fan of the groove (images of the facets about each other,
+/// wedges of angle ψ = π − 2θ around the apex) a beam keeps one direction, and its footprints
+/// change shape when an edge ray — through a rim image or the apex — meets another rim
+/// image or the apex. Rim images lie at distance L and angles θ + kψ, so those lines have
+/// the directions θ + kψ/2 and θ + kψ/2 + π/2 (mod π): grazing a facet is k = 0 and 2. The
+/// 2-D direction of a beam, atan2(−d_z, −d·b(φ)), takes such an angle β where
+/// cos(φ − φ_d) = d_z/(d_h tan β).
 fn azimuth_breaks(theta: f64, i: Vec3, o: Vec3) -> Vec<f64> {
     let mut out = Vec::new();
-    let cot = theta.cos() / theta.sin().max(1e-300);
+    let psi = PI - 2.0 * theta;
+    // Every k up to 2π/ψ for open grooves; deep grooves keep the first few (the kinks of
+    // long chains carry little energy, and each break costs a rule of 15 nodes).
+    let count = ((2.0 * PI / psi.max(PSI_MIN)).ceil() as usize).min(8);
     for d in [i, o] {
         let dh = (d.x * d.x + d.y * d.y).sqrt();
         if dh < 1e-12 {
             continue;
         }
         let pd = d.y.atan2(d.x);
-        for s in [-1.0, 1.0] {
-            let v = s * d.z * cot / dh;
-            if v.abs() <= 1.0 {
-                let a = v.acos();
-                for p in [pd + a, pd - a] {
-                    out.push(p.rem_euclid(PI));
+        for k in 0..count {
+            for extra in [0.0, 0.5 * PI] {
+                let beta = theta + 0.5 * k as f64 * psi + extra;
+                let t = beta.tan();
+                if !t.is_finite() || t.abs() < 1e-300 {
+                    continue;
+                }
+                let v = d.z / (dh * t);
+                if v.abs() <= 1.0 {
+                    let a = v.acos();
+                    for p in [pd + a, pd - a] {
+                        out.push(p.rem_euclid(PI));
+                    }
                 }
             }
         }
     }
+    out.sort_by(f64::total_cmp);
+    out.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
     out
 }
 

@@ -275,14 +275,7 @@ impl MaterialRecipe {
                 evaluation,
                 scattering,
                 multiple_tolerance,
-            } => il::build_il(
-                *kd,
-                *ni,
-                lobe,
-                evaluation,
-                *scattering,
-                *multiple_tolerance,
-            ),
+            } => il::build_il(*kd, *ni, lobe, evaluation, *scattering, *multiple_tolerance),
             MaterialRecipe::Glint(g) => Ok(g.build_default()),
         }
     }
