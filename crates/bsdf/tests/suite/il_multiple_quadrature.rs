@@ -83,7 +83,7 @@ fn quadrature_agrees_with_the_random_walk() {
         let walk = TwoSided::new(il(kd, ni, ndf.clone(), scattering));
         let single = TwoSided::new(il(kd, ni, ndf.clone(), Scattering::Single));
         let quad = il(kd, ni, ndf, scattering)
-            .with_multiple_quadrature(1e-3)
+            .with_multiple_quadrature(3e-3)
             .unwrap();
         let q = quad.multiple_quadrature().unwrap();
         for &(to, ti, pi) in pairs.iter() {
@@ -205,4 +205,41 @@ fn recipes_select_the_quadrature_for_eval() {
             .to_string();
         assert!(e.contains(why), "{bad}: {e}");
     }
+}
+
+#[test]
+fn coloured_substrates_are_three_grey_ones() {
+    // Each channel has its own resolvent (c_b differs); the coloured evaluation must give,
+    // channel by channel, exactly the grey evaluation with that K_d (checked on the last
+    // channel, the others ordered by K_d).
+    let (wo, wi) = (spherical_direction(0.7, 0.0), spherical_direction(0.5, 2.2));
+    let ndf = || Ndf::Beckmann(Beckmann::isotropic(0.6).unwrap());
+    let lobe = || SpecularLobe::new(ndf(), Masking::VCavity, NormalSampling::Visible).unwrap();
+    let build = |kd: Spectrum| {
+        InterfacedLambertian::new(
+            kd,
+            1.5,
+            Some(lobe()),
+            BodyEvaluation::Adaptive { tolerance: 1e-6 },
+            Scattering::Multiple,
+        )
+        .unwrap()
+        .with_multiple_quadrature(1e-2)
+        .unwrap()
+    };
+    let kd = [0.2, 0.5, 0.9];
+    let coloured = build(Spectrum::rgb(kd[0], kd[1], kd[2]));
+    let c = coloured.multiple_quadrature().unwrap().eval(wi, wo);
+    for (ch, &k) in kd.iter().enumerate().skip(2) {
+        let grey = build(Spectrum::splat(k));
+        let g = grey.multiple_quadrature().unwrap().eval(wi, wo);
+        assert!(
+            (c.value[ch] - g.value[1]).abs() <= 1e-12 * g.value[1],
+            "channel {ch}: {} vs grey {}",
+            c.value[ch],
+            g.value[1]
+        );
+        assert!(g.value[1] > 0.0);
+    }
+    assert!(c.value[0] < c.value[1] && c.value[1] < c.value[2]);
 }
