@@ -7,10 +7,11 @@
 //!
 //! # Derivation
 //!
-//! **Macrosurface integral** (the module notes of [`super::vcavity`]). Grooves cover the
-//! macrosurface with density D(m)(m·n) dω_m [IL18 eq. 2 with the V-cavity microsurface of
-//! IL18 eq. 15]; collimated light from i enters a groove uniformly over its opening, and
-//! if p(o | i, m) is the exit density per steradian of the energy that entered,
+//! **Macrosurface integral** [IL18 eq. 23] (and the module notes of [`super::vcavity`]).
+//! Grooves cover the macrosurface with density D(m)(m·n) dω_m (the V-cavity microsurface of
+//! IL18 eq. 15); collimated light from i enters a groove uniformly over its opening, and
+//! if p(o | i, m) is the exit density per steradian of the energy that entered (IL18's
+//! R^∞(i, o, m) |o·m|/|i·n|, up to the groove's share of the projected area),
 //!
 //! f_ms(i, o) = (1/cos θ_o) ∫ D(m)(m·n) p_ms(o | i, m) dω_m,
 //!
@@ -48,11 +49,14 @@
 //!   2-D view factor cos cos'/(2r)). g_j is tabulated per groove angle and interpolated.
 //!   𝒦 is discretised by Galerkin's method with piecewise-constant J on cells graded toward
 //!   both ends of a facet (and geometrically into the apex, where K_j is homogeneous of
-//!   degree −1); J⁰ enters as exact cell averages of its intervals and E_o as exact cell
-//!   integrals, so the discretisation error is second order in the cell size. The resolvent
-//!   𝒜 = (I − 𝒦)⁻¹𝒦 depends on the groove angle and n_i only (not on i, o or the azimuth):
-//!   it is computed once per quadrature node θ_m and cached, so a new direction pair only
-//!   traces beams and forms ⟨E_o, J⁰⟩ + ⟨E_o, 𝒜J⁰⟩.
+//!   degree −1); the discretisation error is second order in the cell size (measured: 16,
+//!   32, 64 cells differ by 5e-4 and 1.5e-4 relative). The resolvent 𝒜 = (I − 𝒦)⁻¹𝒦 depends
+//!   on the groove angle and n_i only (not on i, o or the azimuth): it is computed once per
+//!   quadrature node θ_m and cached, as its cumulative integral over (receiver, source)
+//!   rectangles, exact at the cell corners and bicubic-Hermite (C¹) between them — so a new
+//!   direction pair only traces beams and forms ⟨E_o, J⁰⟩ + ⟨E_o, 𝒜J⁰⟩, each J⁰ and E_o
+//!   interval pair costing four table look-ups, and the groove density stays smooth in the
+//!   footprint ends (the adaptive rule then converges faster than across cell kinks).
 //! - *Orders.* IL_∞: every body path except (first footprint of the i beam, straight exit).
 //!   IL_2 (exactly two facet events, at least one body event): footprints of bounce count
 //!   (0, 1) and (1, 0) paired directly, plus body → direct flight (j = 0 kernel only) → body.
