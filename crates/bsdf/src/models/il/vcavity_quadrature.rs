@@ -1120,9 +1120,8 @@ mod tests {
 
     #[test]
     fn beams_conserve_energy_with_white_facets() {
-        // F = 1 facets (ni huge is not allowed; use the geometry alone): every footprint's
-        // power either reflects or, with F < 1, enters the body; the exits plus the body
-        // share add to 1.
+        // Every footprint's power either reflects (F) or enters the body (1 − F): the exits
+        // plus the body shares add to the power that entered.
         for theta in [0.2, 0.7, 1.1, 1.4] {
             let w = Wedge::new(theta);
             for a in [-1.2f64, -0.6, -0.1, 0.4, 1.3] {
@@ -1146,9 +1145,9 @@ mod tests {
 
     #[test]
     fn kernel_rows_are_view_factors_without_fresnel() {
-        // n_i = 1: T = 1, F = 0, only the direct chain; ∫ K du' over the other facet plus
-        // the share that leaves through the opening is 1/... : the 2-D view factor from a
-        // point of facet A to facet B is (1 + cos ψ' …) — check against the string rule.
+        // n_i = 1: T = 1, F = 0, so ∫ K_0(u, u') du' over facet B is the 2-D view factor
+        // from a point of facet A to facet B, (cos β_rim − cos β_apex)/2 by the string rule
+        // (β measured from the facet's direction toward its rim).
         let theta: f64 = 0.9;
         let w = Wedge::new(theta);
         let gamma = GaussLegendre::new(GAMMA_GL);
@@ -1164,10 +1163,6 @@ mod tests {
                     0.5 * w.len * wx * ch.kernel(u, up, w.len)
                 })
                 .sum();
-            // String rule: F = (1 + cos ψ − |P−R|/… ) — from P at distance u on A to the
-            // segment B = [apex, rim]: F = (d(P, apex) + L_B − d(P, rim_B)) / (2 u_perp…)
-            // For a point: F = (cos β₁ − cos β₂)/2 with β the angles to the segment ends
-            // measured from the facet line.
             let p = (-w.c * u, w.s * u);
             let rim = (w.c * w.len, w.s * w.len);
             let to_rim = (rim.0 - p.0, rim.1 - p.1);
