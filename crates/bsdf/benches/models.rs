@@ -164,7 +164,7 @@ fn models(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(std::time::Duration::from_millis(300)).measurement_time(std::time::Duration::from_secs(1));
-    targets = models, il_tables, albedo_tables
+    targets = models, il_tables, albedo_tables, il_multiple
 }
 criterion_main!(benches);
 
@@ -214,6 +214,43 @@ fn albedo_tables(c: &mut Criterion) {
     ] {
         g.bench_function(name, |b| {
             b.iter(|| black_box(AlbedoTable::build(&ndf, Masking::SmithCorrelated, fresnel)))
+        });
+    }
+    g.finish();
+}
+
+/// IL_∞ eval with the deterministic V-cavity multiple scattering (issue 18: the target is
+/// 200 direction pairs per second at tolerance 1e-4), per direction pair, with the groove
+/// operators of the quadrature nodes already cached (the steady state of a sweep); the walk
+/// at 100,000 estimates per pair is the alternative (about 0.26 s a pair).
+fn il_multiple(c: &mut Criterion) {
+    let mut g = c.benchmark_group("il-multiple-quadrature");
+    g.sample_size(10);
+    let pairs: Vec<(Vec3, Vec3)> = [
+        (0.3, 0.5, 2.0),
+        (1.1, 0.7, 3.0),
+        (0.9, 1.2, 0.5),
+        (0.2, 1.0, 1.0),
+    ]
+    .iter()
+    .map(|&(to, ti, pi)| (spherical_direction(to, 0.0), spherical_direction(ti, pi)))
+    .collect();
+    for tol in ["1e-4", "1e-3"] {
+        let m = build_material(
+            &parse_inline_table(&format!(
+                "{{type = \"il\", kd = 0.8, ni = 1.5, distribution = \"beckmann\", alpha = 0.5, scattering = \"multiple\", multiple_evaluation = \"quadrature\", tolerance = {tol}}}"
+            ))
+            .unwrap(),
+        )
+        .unwrap();
+        g.throughput(Throughput::Elements(pairs.len() as u64));
+        g.bench_function(format!("beckmann-0.5-tolerance-{tol}"), |b| {
+            let mut rng = Pcg32::new(1, 1);
+            b.iter(|| {
+                for (wo, wi) in &pairs {
+                    black_box(m.eval(*wo, *wi, &BsdfContext::RADIANCE, &mut rng));
+                }
+            })
         });
     }
     g.finish();

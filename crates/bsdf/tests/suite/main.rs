@@ -3,6 +3,7 @@
 //! the threads.
 
 mod glints;
+mod il_multiple_quadrature;
 mod il_quadrature_reference;
 mod interfaced_lambertian;
 mod material_params_proptest;

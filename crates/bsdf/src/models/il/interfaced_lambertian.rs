@@ -27,7 +27,10 @@
 //! **Multiple scattering**  [IL18 §3.3]: `scattering = "double"` (IL₂) or `"multiple"`
 //! (IL_∞) adds the V-cavity inter-reflections of [`super::vcavity`], estimated without bias
 //! by a random walk with next-event estimation (one groove per evaluation); it requires
-//! `masking = "v-cavity"` so that every order uses the same microsurface.
+//! `masking = "v-cavity"` so that every order uses the same microsurface. With
+//! [`InterfacedLambertian::with_multiple_quadrature`] (`multiple_evaluation = "quadrature"`)
+//! `eval` computes the same orders deterministically, purely specular chains included, by
+//! [`super::vcavity_quadrature`]; `sample` keeps the walk.
 //!
 //! Flat IL is `evaluation`-independent (closed form). IL with n_i = 1 is the exact
 //! Oren–Nayar model when the distribution is Gaussian with V-cavity masking.
@@ -35,6 +38,7 @@
 use super::il_approx::IlApprox;
 use super::il_table::BodyTable;
 use super::vcavity::{self, IlFacet, Orders};
+use super::vcavity_quadrature::VCavityQuadrature;
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::{ParamError, ParamResult};
@@ -133,6 +137,9 @@ pub struct InterfacedLambertian {
     scattering: Scattering,
     /// Probability of sampling the specular lobe (rough IL).
     specular_probability: f64,
+    /// Deterministic multiple scattering for `eval` (`multiple_evaluation = "quadrature"`);
+    /// `None`: the V-cavity walk. Sampling always uses the walk.
+    ms_quadrature: Option<Arc<VCavityQuadrature>>,
 }
 
 impl InterfacedLambertian {
@@ -188,7 +195,36 @@ impl InterfacedLambertian {
             evaluation,
             scattering,
             specular_probability,
+            ms_quadrature: None,
         })
+    }
+
+    /// Evaluates the V-cavity multiple scattering (IL_2 / IL_∞) deterministically, by the
+    /// quadrature of [`super::vcavity_quadrature`] to the relative `tolerance`, in `eval`
+    /// and `eval_estimate`; `sample` keeps the unbiased walk (its weight has the same
+    /// expectation). Single scattering, or flat IL, ignores it.
+    pub fn with_multiple_quadrature(mut self, tolerance: f64) -> ParamResult<Self> {
+        check_tolerance(tolerance)?;
+        let orders = match self.scattering {
+            Scattering::Single => return Ok(self),
+            Scattering::Double => Orders::Second,
+            Scattering::Multiple => Orders::SecondAndHigher,
+        };
+        if let Some(l) = &self.lobe {
+            self.ms_quadrature = Some(Arc::new(VCavityQuadrature::new(
+                l.ndf.clone(),
+                self.ni,
+                self.body_factor,
+                orders,
+                tolerance,
+            )));
+        }
+        Ok(self)
+    }
+
+    /// The deterministic multiple-scattering evaluator, when configured.
+    pub fn multiple_quadrature(&self) -> Option<&VCavityQuadrature> {
+        self.ms_quadrature.as_deref()
     }
 
     pub fn kd(&self) -> Spectrum {
@@ -289,6 +325,14 @@ impl InterfacedLambertian {
         (spec + k * b, k * se)
     }
 
+    /// The multiple-scattering part for `eval`: the quadrature when configured, else one walk.
+    fn multiple_eval(&self, o: Vec3, i: Vec3, rng: &mut dyn RandomSource) -> Spectrum {
+        match &self.ms_quadrature {
+            Some(q) => q.eval(i, o).value,
+            None => self.multiple(o, i, rng),
+        }
+    }
+
     /// The multiple-scattering part (orders ≥ 2) for the upper-hemisphere pair: one V-cavity
     /// walk per estimate.
     fn multiple(&self, o: Vec3, i: Vec3, rng: &mut dyn RandomSource) -> Spectrum {
@@ -330,6 +374,8 @@ impl OpaqueBsdf for InterfacedLambertian {
         spec | LobeFlags::DIFFUSE_REFLECTION
     }
 
+    // With `multiple_evaluation = "quadrature"` eval is deterministic but `sample`'s weight
+    // still carries one walk: the model stays stochastic for the consistency checks.
     fn is_stochastic(&self) -> bool {
         self.lobe.is_some()
             && (matches!(self.evaluation, BodyEvaluation::Stochastic)
@@ -338,7 +384,7 @@ impl OpaqueBsdf for InterfacedLambertian {
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
         let (o, i) = (wo, wi);
-        let v = self.single(o, i, 1, rng).0 + self.multiple(o, i, rng);
+        let v = self.single(o, i, 1, rng).0 + self.multiple_eval(o, i, rng);
         guard(v, || {
             format!("{} eval(wo = {wo:?}, wi = {wi:?})", self.describe())
         })
@@ -356,6 +402,11 @@ impl OpaqueBsdf for InterfacedLambertian {
         let (single, single_se) = self.single(o, i, samples.max(2), rng);
         if self.scattering == Scattering::Single || self.lobe.is_none() {
             return (single, single_se);
+        }
+        if let Some(q) = &self.ms_quadrature {
+            let ms = q.eval(i, o);
+            let se = (single_se * single_se + ms.error * ms.error).map(f64::sqrt);
+            return (single + ms.value, se);
         }
         let (ms, ms_se) = crate::bsdf::mean_and_stderr(samples, || self.multiple(o, i, rng));
         let se = (single_se * single_se + ms_se * ms_se).map(f64::sqrt);
@@ -448,8 +499,12 @@ impl OpaqueBsdf for InterfacedLambertian {
             }
             e => e.name().to_string(),
         };
+        let ms = match &self.ms_quadrature {
+            Some(q) => format!(" (quadrature tolerance {})", fmt_num(q.tolerance())),
+            None => String::new(),
+        };
         format!(
-            "il(kd={:?}, ni={}, {rough}, body={ev}, scattering={})",
+            "il(kd={:?}, ni={}, {rough}, body={ev}, scattering={}{ms})",
             self.kd.0,
             fmt_num(self.ni),
             self.scattering.name()

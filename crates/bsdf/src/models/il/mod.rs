@@ -14,5 +14,6 @@ pub mod il_table;
 pub mod il_table_part;
 pub mod interfaced_lambertian;
 pub mod vcavity;
+pub mod vcavity_quadrature;
 
 pub use interfaced_lambertian::InterfacedLambertian;

@@ -26,7 +26,11 @@ pub(super) const IL_KEYS: &[&str] = &[
     "tolerance",
     "table",
     "scattering",
+    "multiple_evaluation",
 ];
+
+/// Default relative tolerance of `multiple_evaluation = "quadrature"`.
+pub const DEFAULT_MULTIPLE_TOLERANCE: f64 = 1e-4;
 
 /// How an interfaced-Lambertian recipe evaluates its body term.
 #[derive(Clone, Debug)]
@@ -92,14 +96,42 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
         evaluation,
         IlEvaluation::Quadrature { .. } | IlEvaluation::Adaptive { .. }
     );
+    let multiple_tolerance = match p.str("multiple_evaluation")? {
+        None | Some("stochastic") => None,
+        Some("quadrature") => {
+            if scattering == Scattering::Single {
+                return Err(ParamError::Invalid(
+                    "`multiple_evaluation` applies to scattering = \"double\" or \"multiple\""
+                        .into(),
+                ));
+            }
+            if ndf.is_none() {
+                return Err(ParamError::Invalid(
+                    "`multiple_evaluation` needs a rough IL (flat IL has no V-cavities)".into(),
+                ));
+            }
+            // `tolerance` also sets the body quadrature's when evaluation = "quadrature".
+            Some(check_tolerance(
+                tolerance.unwrap_or(DEFAULT_MULTIPLE_TOLERANCE),
+            )?)
+        }
+        Some(other) => {
+            return Err(choice(
+                "multiple_evaluation",
+                other,
+                &["stochastic", "quadrature"],
+            ))
+        }
+    };
     if samples.is_some() && !quadrature {
         return Err(ParamError::Invalid(
             "`samples` applies to evaluation = \"quadrature\"".into(),
         ));
     }
-    if tolerance.is_some() && !quadrature {
+    if tolerance.is_some() && !quadrature && multiple_tolerance.is_none() {
         return Err(ParamError::Invalid(
-            "`tolerance` applies to evaluation = \"quadrature\"".into(),
+            "`tolerance` applies to evaluation = \"quadrature\" or multiple_evaluation = \"quadrature\""
+                .into(),
         ));
     }
     if table_path.is_some() && !matches!(evaluation, IlEvaluation::Table(_)) {
@@ -118,6 +150,7 @@ pub(super) fn parse_il(p: &Params, base_dir: &std::path::Path) -> ParamResult<Ma
         lobe,
         evaluation,
         scattering,
+        multiple_tolerance,
     };
     recipe.build()?;
     Ok(recipe)
@@ -140,6 +173,7 @@ pub(super) fn build_il(
     lobe: &Option<SpecularLobe>,
     evaluation: &IlEvaluation,
     scattering: Scattering,
+    multiple_tolerance: Option<f64>,
 ) -> ParamResult<Arc<dyn Bsdf>> {
     let ev = match evaluation {
         IlEvaluation::Stochastic => BodyEvaluation::Stochastic,
@@ -153,11 +187,9 @@ pub(super) fn build_il(
             None => BodyEvaluation::Stochastic,
         },
     };
-    Ok(Arc::new(TwoSided::new(InterfacedLambertian::new(
-        kd,
-        ni,
-        lobe.clone(),
-        ev,
-        scattering,
-    )?)))
+    let mut il = InterfacedLambertian::new(kd, ni, lobe.clone(), ev, scattering)?;
+    if let Some(t) = multiple_tolerance {
+        il = il.with_multiple_quadrature(t)?;
+    }
+    Ok(Arc::new(TwoSided::new(il)))
 }

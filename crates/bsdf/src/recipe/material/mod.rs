@@ -124,6 +124,9 @@ pub enum MaterialRecipe {
         lobe: Option<SpecularLobe>,
         evaluation: IlEvaluation,
         scattering: Scattering,
+        /// `multiple_evaluation = "quadrature"`: the V-cavity multiple scattering by
+        /// quadrature to this relative tolerance (`None`: the walk).
+        multiple_tolerance: Option<f64>,
     },
     /// Glints [CCM19]: its BSDF depends on the footprint of each shading point
     /// ([`MaterialRecipe::build_at`]).
@@ -271,7 +274,8 @@ impl MaterialRecipe {
                 lobe,
                 evaluation,
                 scattering,
-            } => il::build_il(*kd, *ni, lobe, evaluation, *scattering),
+                multiple_tolerance,
+            } => il::build_il(*kd, *ni, lobe, evaluation, *scattering, *multiple_tolerance),
             MaterialRecipe::Glint(g) => Ok(g.build_default()),
         }
     }
@@ -282,8 +286,12 @@ impl MaterialRecipe {
     /// renderer warns about it; the lab wants exactly that.
     pub fn render_cost_warning(&self) -> Option<&'static str> {
         let adaptive = match self {
-            MaterialRecipe::Il { evaluation, .. } => {
-                matches!(evaluation, IlEvaluation::Adaptive { .. })
+            MaterialRecipe::Il {
+                evaluation,
+                multiple_tolerance,
+                ..
+            } => {
+                matches!(evaluation, IlEvaluation::Adaptive { .. }) || multiple_tolerance.is_some()
             }
             MaterialRecipe::OrenNayar { evaluation, .. } => matches!(
                 evaluation,
@@ -292,9 +300,9 @@ impl MaterialRecipe {
             _ => false,
         };
         adaptive.then_some(
-            "evaluation = \"quadrature\" integrates adaptively to its tolerance at every \
-             shading point (about 2 ms each): renders want evaluation = \"stochastic\" or \
-             a fixed set, samples = N",
+            "evaluation = \"quadrature\" (or multiple_evaluation = \"quadrature\") integrates \
+             adaptively to its tolerance at every shading point (milliseconds each): renders \
+             want evaluation = \"stochastic\" or a fixed set, samples = N, and the V-cavity walk",
         )
     }
 
