@@ -18,6 +18,16 @@ def spherical(theta_deg, phi_deg):
 ROWS = np.array([[0, 0, 30, 180], [30, 0, 60, 180], [45, 90, 10, 0], [70, 0, 70, 180], [20, 0, 150, 30]], float)
 
 
+def cli_eval(facette_bin, spec, samples, *flags):
+    """`facette eval` of ROWS with seed 4: the columns after the four angles."""
+    csv = "\n".join(",".join(f"{v:g}" for v in r) for r in ROWS)
+    out = subprocess.run(
+        [facette_bin, "eval", "--material", spec, "--samples", str(samples), "--seed", "4", *flags],
+        input=csv, capture_output=True, text=True, check=True,
+    ).stdout
+    return np.array([[float(x) for x in line.split(",")[4:]] for line in out.strip().splitlines()[1:]])
+
+
 @pytest.mark.parametrize(
     "spec, samples",
     [
@@ -28,12 +38,7 @@ ROWS = np.array([[0, 0, 30, 180], [30, 0, 60, 180], [45, 90, 10, 0], [70, 0, 70,
     ],
 )
 def test_eval_equals_the_cli(facette_bin, spec, samples):
-    csv = "\n".join(",".join(f"{v:g}" for v in r) for r in ROWS)
-    out = subprocess.run(
-        [facette_bin, "eval", "--material", spec, "--samples", str(samples), "--seed", "4"],
-        input=csv, capture_output=True, text=True, check=True,
-    ).stdout
-    cli = np.array([[float(x) for x in line.split(",")[4:]] for line in out.strip().splitlines()[1:]])
+    cli = cli_eval(facette_bin, spec, samples)
     m = facette.Material(spec)
     wi = spherical(ROWS[:, 0], ROWS[:, 1])
     wo = spherical(ROWS[:, 2], ROWS[:, 3])
@@ -55,12 +60,7 @@ def test_eval_equals_the_cli(facette_bin, spec, samples):
     ],
 )
 def test_eval_with_error_equals_the_cli(facette_bin, spec, samples):
-    csv = "\n".join(",".join(f"{v:g}" for v in r) for r in ROWS)
-    out = subprocess.run(
-        [facette_bin, "eval", "--material", spec, "--samples", str(samples), "--seed", "4", "--with-error"],
-        input=csv, capture_output=True, text=True, check=True,
-    ).stdout
-    cli = np.array([[float(x) for x in line.split(",")[4:]] for line in out.strip().splitlines()[1:]])
+    cli = cli_eval(facette_bin, spec, samples, "--with-error")
     m = facette.Material(spec)
     wi = spherical(ROWS[:, 0], ROWS[:, 1])
     wo = spherical(ROWS[:, 2], ROWS[:, 3])
