@@ -137,6 +137,7 @@ macro_rules! array_lanes {
             type Mask = $mask;
             const LANES: usize = $n;
             const TINY: f64 = $tiny;
+            const DIGITS: u32 = <$elem>::MANTISSA_DIGITS;
 
             #[inline(always)]
             fn splat(v: f64) -> Self {

@@ -1,6 +1,7 @@
 //! One source, several widths: the [`Real`] lane trait and its instantiations (`f64` for the
-//! lab, `f32` and [`F32x8`] for the renderer's kernel, [`F64x4`] for its geometry) and the
-//! lane vector [`LVec3`] — the bottom layer of the lane code, beside `math`. The models that
+//! lab, `f32` and [`F32x8`] for the renderer's kernel, [`F64x4`] and [`F64x8`] for its
+//! geometry), the integer lanes [`Bits32`] (`u32` and [`U32x8`], the samplers' hashing) and
+//! the lane vector [`LVec3`] — the bottom layer of the lane code, beside `math`. The models that
 //! vectorize are `models::lane_models`, over these lanes. The microfacet core
 //! (`microfacet::{Ggx, Beckmann}`'s `*_lanes` methods, `fresnel::*_lanes`) is the source
 //! the f64 [`Distribution`](crate::microfacet::Distribution) methods instantiate.
@@ -8,10 +9,16 @@
 pub(crate) mod array_lanes;
 mod f32x8;
 mod f64x4;
+mod f64x8;
+mod frame;
 mod real;
+mod u32x8;
 mod vec3;
 
 pub use f32x8::{F32x8, M32x8};
 pub use f64x4::{F64x4, M64x4};
+pub use f64x8::{F64x8, M64x8};
+pub use frame::LFrame;
 pub use real::{Mask, Real};
+pub use u32x8::{Bits32, U32x8};
 pub use vec3::LVec3;

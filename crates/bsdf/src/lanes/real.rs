@@ -63,6 +63,8 @@ pub trait Real:
     const LANES: usize;
     /// The smallest value a guard against underflow may use: 1e-300 in f64, 1e-30 in f32.
     const TINY: f64;
+    /// Significand bits of a lane (53 for f64, 24 for f32).
+    const DIGITS: u32;
 
     fn splat(v: f64) -> Self;
     /// Lane `i` as f64.
@@ -123,6 +125,7 @@ macro_rules! scalar_real {
             type Mask = bool;
             const LANES: usize = 1;
             const TINY: f64 = $tiny;
+            const DIGITS: u32 = <$t>::MANTISSA_DIGITS;
             #[inline(always)]
             fn splat(v: f64) -> Self {
                 v as $t

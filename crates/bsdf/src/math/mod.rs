@@ -89,29 +89,16 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// Frame around a unit normal, tangents chosen by Duff et al.'s branchless construction.
+    /// Frame around a unit normal, tangents chosen by Duff et al.'s branchless construction
+    /// (one source with the lanes' [`LFrame::from_normal`](crate::lanes::LFrame)).
     pub fn from_normal(n: Vec3) -> Self {
-        let sign = 1.0f64.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-        Frame { s, t, n }
+        crate::lanes::LFrame::<f64>::from_normal(n.into()).into()
     }
 
-    /// Frame with a given normal and a preferred tangent direction (Gram–Schmidt).
+    /// Frame with a given normal and a preferred tangent direction (Gram–Schmidt), Duff's
+    /// where the tangent is (nearly) parallel to the normal.
     pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Self {
-        let s = tangent - n * n.dot(tangent);
-        let len = s.length();
-        if !(len > 1e-12) {
-            return Self::from_normal(n);
-        }
-        let s = s / len;
-        Frame {
-            s,
-            t: n.cross(s),
-            n,
-        }
+        crate::lanes::LFrame::<f64>::from_normal_tangent(n.into(), tangent.into()).into()
     }
 
     #[inline]
@@ -122,6 +109,17 @@ impl Frame {
     #[inline]
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+impl From<crate::lanes::LFrame<f64>> for Frame {
+    #[inline(always)]
+    fn from(f: crate::lanes::LFrame<f64>) -> Self {
+        Frame {
+            s: f.s.into(),
+            t: f.t.into(),
+            n: f.n.into(),
+        }
     }
 }
 

@@ -1,5 +1,7 @@
 //! Special functions: error function and its inverse, log-gamma and the Beta function.
 
+use crate::lanes::{Mask, Real};
+
 /// Error function (libm's double-precision implementation, relative error ~1e-16).
 #[inline]
 pub fn erf(x: f64) -> f64 {
@@ -17,32 +19,57 @@ pub fn erfc(x: f64) -> f64 {
 /// initial guess for iterations that refine it.
 #[inline]
 pub fn erfinv_approx(y: f64) -> f64 {
-    let w = -((1.0 - y) * (1.0 + y)).ln();
-    if w < 5.0 {
-        let w = w - 2.5;
-        let mut p = 2.810_226_36e-08;
-        p = 3.432_739_39e-07 + p * w;
-        p = -3.523_387_7e-06 + p * w;
-        p = -4.391_506_54e-06 + p * w;
-        p = 0.000_218_580_87 + p * w;
-        p = -0.001_253_725_03 + p * w;
-        p = -0.004_177_681_64 + p * w;
-        p = 0.246_640_727 + p * w;
-        p = 1.501_409_41 + p * w;
-        p * y
+    erfinv_approx_lanes(y)
+}
+
+/// [`erfinv_approx`] over lanes, its one source: each of Giles' two branches is evaluated
+/// where some lane needs it, and selected per lane.
+#[inline(always)]
+pub fn erfinv_approx_lanes<R: Real>(y: R) -> R {
+    let horner = |w: R, c: &[f64]| {
+        c[1..]
+            .iter()
+            .fold(R::splat(c[0]), |p, &k| R::splat(k) + p * w)
+    };
+    let w = -((R::one() - y) * (R::one() + y)).ln();
+    let central = w.lt(R::splat(5.0));
+    let inner = if central.any() {
+        horner(
+            w - R::splat(2.5),
+            &[
+                2.810_226_36e-08,
+                3.432_739_39e-07,
+                -3.523_387_7e-06,
+                -4.391_506_54e-06,
+                0.000_218_580_87,
+                -0.001_253_725_03,
+                -0.004_177_681_64,
+                0.246_640_727,
+                1.501_409_41,
+            ],
+        )
     } else {
-        let w = w.sqrt() - 3.0;
-        let mut p = -0.000_200_214_257;
-        p = 0.000_100_950_558 + p * w;
-        p = 0.001_349_343_22 + p * w;
-        p = -0.003_673_428_44 + p * w;
-        p = 0.005_739_507_73 + p * w;
-        p = -0.007_622_461_3 + p * w;
-        p = 0.009_438_870_47 + p * w;
-        p = 1.001_674_06 + p * w;
-        p = 2.832_976_82 + p * w;
-        p * y
-    }
+        R::zero()
+    };
+    let outer = if (!central).any() {
+        horner(
+            w.sqrt() - R::splat(3.0),
+            &[
+                -0.000_200_214_257,
+                0.000_100_950_558,
+                0.001_349_343_22,
+                -0.003_673_428_44,
+                0.005_739_507_73,
+                -0.007_622_461_3,
+                0.009_438_870_47,
+                1.001_674_06,
+                2.832_976_82,
+            ],
+        )
+    } else {
+        R::zero()
+    };
+    R::select(central, inner, outer) * y
 }
 
 /// Giles' double-precision erfinv polynomials ("Approximating the erfinv function", GPU

@@ -1,22 +1,35 @@
 //! Sampling warps from [0, 1)² to directions, and low-discrepancy point sets.
 
 use super::{Vec2, Vec3, INV_PI, PI, TWO_PI};
+use crate::lanes::{LVec3, Real};
 
 /// Concentric map of the unit square to the unit disk (Shirley & Chiu 1997).
 #[inline]
 pub fn square_to_disk_concentric(u: Vec2) -> Vec2 {
-    let a = 2.0 * u.x - 1.0;
-    let b = 2.0 * u.y - 1.0;
-    if a == 0.0 && b == 0.0 {
-        return Vec2::ZERO;
-    }
-    let (r, phi) = if a * a > b * b {
-        (a, (PI / 4.0) * (b / a))
-    } else {
-        (b, PI / 2.0 - (PI / 4.0) * (a / b))
-    };
+    let (x, y) = square_to_disk_concentric_lanes(u.x, u.y);
+    Vec2::new(x, y)
+}
+
+/// [`square_to_disk_concentric`] over lanes, its one source: both wedges' angles are
+/// computed and one selected per lane (the other may divide by zero and is discarded).
+#[inline(always)]
+pub fn square_to_disk_concentric_lanes<R: Real>(u0: R, u1: R) -> (R, R) {
+    let a = R::splat(2.0) * u0 - R::one();
+    let b = R::splat(2.0) * u1 - R::one();
+    let quarter = R::splat(PI / 4.0);
+    let first = (a * a).gt(b * b);
+    let r = R::select(first, a, b);
+    let phi = R::select(
+        first,
+        quarter * (b / a),
+        R::splat(PI / 2.0) - quarter * (a / b),
+    );
     let (s, c) = phi.sin_cos();
-    Vec2::new(r * c, r * s)
+    let centre = a.eq(R::zero()) & b.eq(R::zero());
+    (
+        R::select(centre, R::zero(), r * c),
+        R::select(centre, R::zero(), r * s),
+    )
 }
 
 /// Cosine-weighted hemisphere sample (pdf = cos θ / π), Malley's method.
@@ -35,10 +48,16 @@ pub fn cosine_hemisphere_pdf(v: Vec3) -> f64 {
 /// Uniform sample of the unit sphere (pdf = 1/4π).
 #[inline]
 pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (TWO_PI * u.y).sin_cos();
-    Vec3::new(r * c, r * s, z)
+    square_to_uniform_sphere_lanes(u.x, u.y).into()
+}
+
+/// [`square_to_uniform_sphere`] over lanes, its one source.
+#[inline(always)]
+pub fn square_to_uniform_sphere_lanes<R: Real>(u0: R, u1: R) -> LVec3<R> {
+    let z = R::one() - R::splat(2.0) * u0;
+    let r = (R::one() - z * z).max(R::zero()).sqrt();
+    let (s, c) = (R::splat(TWO_PI) * u1).sin_cos();
+    LVec3::new(r * c, r * s, z)
 }
 
 /// Uniform sample of the upper hemisphere (pdf = 1/2π).

@@ -192,20 +192,7 @@ fn tinted<R: Real>(tint: &[f64; 3], v: R) -> [R; 3] {
 /// `square_to_cosine_hemisphere`).
 #[inline(always)]
 fn cosine_hemisphere<R: Real>(u0: R, u1: R) -> LVec3<R> {
-    let a = R::splat(2.0) * u0 - R::one();
-    let b = R::splat(2.0) * u1 - R::one();
-    let quarter = R::splat(std::f64::consts::FRAC_PI_4);
-    let first = (a * a).gt(b * b);
-    let r = R::select(first, a, b);
-    let phi = R::select(
-        first,
-        quarter * (b / a),
-        R::splat(std::f64::consts::FRAC_PI_2) - quarter * (a / b),
-    );
-    let (s, c) = phi.sin_cos();
-    let centre = a.eq(R::zero()) & b.eq(R::zero());
-    let x = R::select(centre, R::zero(), r * c);
-    let y = R::select(centre, R::zero(), r * s);
+    let (x, y) = crate::math::warp::square_to_disk_concentric_lanes(u0, u1);
     let z = (R::one() - (x * x + y * y)).max(R::zero()).sqrt();
     LVec3::new(x, y, z)
 }
