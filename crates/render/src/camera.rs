@@ -4,7 +4,8 @@
 //! sensor scales x and y by −½ from its normalized device coordinates).
 
 use crate::geometry::{Ray, RayDifferential, Transform, Vec2, Vec3};
-use facette_bsdf::math::warp::square_to_disk_concentric;
+use facette_bsdf::lanes::{LVec3, Real};
+use facette_bsdf::math::warp::{square_to_disk_concentric, square_to_disk_concentric_lanes};
 
 /// Which image axis `fov` spans (Mitsuba's `fov_axis`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,8 +149,39 @@ impl Camera {
     /// whose materials read no texture footprint); the same ray as
     /// [`generate_ray`](Self::generate_ray)'s.
     pub fn generate_primary_ray(&self, x: f64, y: f64, u_lens: Vec2) -> Ray {
-        let (o, dir) = self.through_lens(u_lens);
-        Ray::infinite(o, dir(self.local_dir(x, y)))
+        let (o, d) = self.primary_rays(x, y, (u_lens.x, u_lens.y));
+        Ray {
+            origin: o.into(),
+            dir: d.into(),
+            t_max: f64::INFINITY,
+        }
+    }
+
+    /// [`generate_primary_ray`](Self::generate_primary_ray) over lanes of film positions
+    /// and lens samples — its one source, with glam's order of operations — as (origins,
+    /// unit directions; normalized twice, as the ray constructor did).
+    #[inline(always)]
+    pub fn primary_rays<R: Real>(&self, x: R, y: R, u_lens: (R, R)) -> (LVec3<R>, LVec3<R>) {
+        let one = R::one();
+        let sx = one - R::splat(2.0) * x / R::splat(self.width as f64);
+        let sy = one - R::splat(2.0) * y / R::splat(self.height as f64);
+        let dl = LVec3::new(sx * R::splat(self.tan_x), sy * R::splat(self.tan_y), one);
+        let axes = |v: LVec3<R>| {
+            let col = |c: glam::DVec3| LVec3::new(R::splat(c.x), R::splat(c.y), R::splat(c.z));
+            let res = col(self.axes.x_axis).scale(v.x);
+            let res = res + col(self.axes.y_axis).scale(v.y);
+            res + col(self.axes.z_axis).scale(v.z)
+        };
+        if self.lens_radius > 0.0 {
+            let (lx, ly) = square_to_disk_concentric_lanes(u_lens.0, u_lens.1);
+            let r = R::splat(self.lens_radius);
+            let lens = LVec3::new(lx * r, ly * r, R::zero());
+            let origin = self.to_world.point_lanes(lens);
+            let focus = dl.scale(R::splat(self.focus_distance) / dl.z);
+            (origin, axes(focus - lens).normalize().normalize())
+        } else {
+            (LVec3::splat(self.origin), axes(dl).normalize().normalize())
+        }
     }
 
     /// The primary ray through film position (x, y) and its differentials toward

@@ -6,6 +6,8 @@
 
 use crate::geometry::Vec2;
 use crate::image::RgbImage;
+use facette_bsdf::lanes::Real;
+use facette_bsdf::math::special::erfinv_approx_lanes;
 use facette_bsdf::Spectrum;
 
 /// Reconstruction filter.
@@ -38,8 +40,15 @@ impl Filter {
 
     /// Offset from the pixel centre for the unit sample `u`.
     pub fn sample(&self, u: Vec2) -> Vec2 {
+        let (x, y) = self.sample_lanes(u.x, u.y);
+        Vec2::new(x, y)
+    }
+
+    /// [`sample`](Self::sample) over lanes, its one source.
+    #[inline(always)]
+    pub fn sample_lanes<R: Real>(&self, u0: R, u1: R) -> (R, R) {
         match *self {
-            Filter::Box => u - Vec2::splat(0.5),
+            Filter::Box => (u0 - R::splat(0.5), u1 - R::splat(0.5)),
             Filter::Gaussian {
                 stddev,
                 radius,
@@ -48,12 +57,12 @@ impl Filter {
                 // Separable truncated Gaussian by inverting the normal CDF restricted to
                 // [−radius, radius]; Giles' erfinv (1e-7 relative) is ample for placing a
                 // sample within a pixel and 5× cheaper than the refined one.
-                let k = stddev * std::f64::consts::SQRT_2;
-                let f = |x: f64| {
-                    let y = (2.0 * x - 1.0) * mass;
-                    (k * facette_bsdf::math::special::erfinv_approx(y)).clamp(-radius, radius)
+                let k = R::splat(stddev * std::f64::consts::SQRT_2);
+                let f = |x: R| {
+                    let y = (R::splat(2.0) * x - R::one()) * R::splat(mass);
+                    (k * erfinv_approx_lanes(y)).clamp(-radius, radius)
                 };
-                Vec2::new(f(u.x), f(u.y))
+                (f(u0), f(u1))
             }
         }
     }

@@ -254,14 +254,14 @@ fn render_in_pool(
                 let y0 = ty * TILE;
                 let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
                 let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
-                for y in y0..y1 {
-                    // Checked per row: a pass of many samples is stopped promptly; the rows
-                    // left out keep the samples of the earlier passes.
-                    if should_stop(pass) {
-                        break;
-                    }
-                    match kernel {
-                        Kernel::Scalar => {
+                match kernel {
+                    Kernel::Scalar => {
+                        for y in y0..y1 {
+                            // Checked per row: a pass of many samples is stopped promptly;
+                            // the rows left out keep the samples of the earlier passes.
+                            if should_stop(pass) {
+                                break;
+                            }
                             for x in x0..x1 {
                                 let mut p = PixelSums::default();
                                 for &s in chunk {
@@ -271,24 +271,29 @@ fn render_in_pool(
                                 }
                                 out.push(p);
                             }
-                        }
-                        Kernel::Packet => {
-                            let first = out.len();
-                            out.resize(first + (x1 - x0), PixelSums::default());
-                            packet::render_row(
-                                scene,
-                                &sampler,
-                                cameras,
-                                opts.strategy,
-                                (x0..x1, y),
-                                chunk,
-                                &mut out[first..],
-                            );
+                            let row = ((x1 - x0) * chunk.len()) as u64;
+                            let d = done.fetch_add(row, Ordering::Relaxed) + row;
+                            progress(d, total);
                         }
                     }
-                    let row = ((x1 - x0) * chunk.len()) as u64;
-                    let d = done.fetch_add(row, Ordering::Relaxed) + row;
-                    progress(d, total);
+                    Kernel::Packet => {
+                        // The same stop rule: asked before each row is started.
+                        let stop = || should_stop(pass);
+                        let job = packet::TileJob {
+                            scene,
+                            sampler: &sampler,
+                            cameras,
+                            strategy: opts.strategy,
+                            xs: x0..x1,
+                            ys: y0..y1,
+                            chunk,
+                            stop: &stop,
+                        };
+                        let rows = packet::render_tile(&job, &mut out);
+                        let n = (rows * (x1 - x0) * chunk.len()) as u64;
+                        let d = done.fetch_add(n, Ordering::Relaxed) + n;
+                        progress(d, total);
+                    }
                 }
                 (tx, ty, out)
             })

@@ -20,6 +20,7 @@
 //! no `t_min` to tune.
 
 use super::Vec3;
+use facette_bsdf::lanes::{LVec3, Real};
 
 /// Relative offset of spawned ray origins; see the module documentation.
 pub const RAY_EPSILON: f64 = 1.0 / (1u64 << 30) as f64;
@@ -105,9 +106,16 @@ fn segment(origin: Vec3, target: Vec3) -> Ray {
 /// normal `ng` to the side `dir` points to, by `(1 + max|pᵢ|) · RAY_EPSILON`.
 #[inline]
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let mag = (1.0 + p.abs().max_element()) * RAY_EPSILON;
-    let signed = if ng.dot(dir) >= 0.0 { mag } else { -mag };
-    p + signed * ng
+    offset_origin_lanes::<f64>(p.into(), ng.into(), dir.into()).into()
+}
+
+/// [`offset_origin`] over lanes, its one source.
+#[inline(always)]
+pub fn offset_origin_lanes<R: Real>(p: LVec3<R>, ng: LVec3<R>, dir: LVec3<R>) -> LVec3<R> {
+    let largest = p.x.abs().max(p.y.abs().max(p.z.abs()));
+    let mag = (R::one() + largest) * R::splat(RAY_EPSILON);
+    let signed = R::select(ng.dot(dir).ge(R::zero()), mag, -mag);
+    p + ng.scale(signed)
 }
 
 /// The two auxiliary rays of a camera ray, offset by one pixel in x and in y (pbrt's

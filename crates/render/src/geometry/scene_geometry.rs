@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 mod packet;
 
-pub use packet::{PacketHit, PACKET_TRAVERSAL_MAX_NODES};
+pub use packet::{HitLanes, LaneRays, PacketHit, PACKET_TRAVERSAL_MAX_NODES};
 
 /// One BVH primitive: a triangle of a mesh or a whole analytic shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -177,32 +177,47 @@ impl Sphere {
     /// lengths): the frame of an untextured material, without the `acos`/`atan2`/`sqrt` of
     /// the uv parameterization. [`complete_hit`](Self::complete_hit) fills the rest.
     pub fn shading_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {
-        let outward = (ray.at(hit.t) - self.center).normalize_or_zero();
-        let outward = if outward == Vec3::ZERO {
-            -ray.dir
-        } else {
-            outward
-        };
-        // Re-project onto the surface (Mitsuba does the same) to bound the error of `p`.
-        let p = self.center + self.radius * outward;
-        let l = self.to_world.inverse_vector(outward);
-        // The directions of the parameterization's dp/du and dp/dv (see `parameterization`).
-        let dpdu = self.to_world.vector(Vec3::new(-l.y, l.x, 0.0));
+        let (p, n, dpdu, l) =
+            self.shading_hit_lanes::<f64>(ray.origin.into(), ray.dir.into(), hit.t);
+        let l: Vec3 = l.into();
         let dpdv = self
             .to_world
             .vector(Vec3::new(l.z * l.x, l.z * l.y, -(l.x * l.x + l.y * l.y)));
-        let n = if self.flip_normals { -outward } else { outward };
         SurfaceHit {
             t: hit.t,
-            p,
-            ng: n,
-            ns: n,
+            p: p.into(),
+            ng: n.into(),
+            ns: n.into(),
             uv: Vec2::ZERO,
-            dpdu,
+            dpdu: dpdu.into(),
             dpdv,
             shape,
             prim: 0,
         }
+    }
+
+    /// The point, normal and dp/du direction of [`shading_hit`](Self::shading_hit) over
+    /// lanes of rays (origins `o`, directions `d`) hitting at `t` — its one source — and the
+    /// outward direction in object space (dp/dv's direction follows from it).
+    #[inline(always)]
+    pub fn shading_hit_lanes<R: Real>(
+        &self,
+        o: LVec3<R>,
+        d: LVec3<R>,
+        t: R,
+    ) -> (LVec3<R>, LVec3<R>, LVec3<R>, LVec3<R>) {
+        let v = (o + d.scale(t)) - LVec3::splat(self.center);
+        // glam's normalize_or_zero, then −d for a zero vector.
+        let rcp = R::one() / v.length_squared().sqrt();
+        let ok = rcp.is_finite() & rcp.gt(R::zero());
+        let outward = LVec3::select(ok, v.scale(rcp), -d);
+        // Re-project onto the surface (Mitsuba does the same) to bound the error of `p`.
+        let p = LVec3::splat(self.center) + outward.scale(R::splat(self.radius));
+        let l = self.to_world.inverse_vector_lanes(outward);
+        // The direction of the parameterization's dp/du (see `parameterization`).
+        let dpdu = self.to_world.vector_lanes(LVec3::new(-l.y, l.x, R::zero()));
+        let n = if self.flip_normals { -outward } else { outward };
+        (p, n, dpdu, l)
     }
 
     /// Replaces the tangent directions of a [`shading_hit`](Self::shading_hit) by the

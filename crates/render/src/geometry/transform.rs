@@ -9,6 +9,7 @@
 
 use super::error::{GeometryError, GeometryResult};
 use super::{Mat4, Vec3};
+use facette_bsdf::lanes::{LVec3, Real};
 use glam::DVec4;
 
 /// A transform with its precomputed inverse.
@@ -220,6 +221,31 @@ impl Transform {
         self.inv.transform_vector3(v)
     }
 
+    /// [`vector`](Self::vector) over lanes, with glam's order of operations (the same bits
+    /// in `f64` lanes).
+    #[inline(always)]
+    pub fn vector_lanes<R: Real>(&self, v: LVec3<R>) -> LVec3<R> {
+        linear_lanes(&self.m, v)
+    }
+
+    /// [`point`](Self::point) over lanes, with glam's order of operations.
+    #[inline(always)]
+    pub fn point_lanes<R: Real>(&self, p: LVec3<R>) -> LVec3<R> {
+        let m = &self.m;
+        let c = |a: DVec4| [R::splat(a.x), R::splat(a.y), R::splat(a.z), R::splat(a.w)];
+        let (x, y, z, w) = (c(m.x_axis), c(m.y_axis), c(m.z_axis), c(m.w_axis));
+        let h: [R; 4] = std::array::from_fn(|k| ((x[k] * p.x + y[k] * p.y) + z[k] * p.z) + w[k]);
+        let affine = h[3].eq(R::one());
+        let div = |v: R| R::select(affine, v, v / h[3]);
+        LVec3::new(div(h[0]), div(h[1]), div(h[2]))
+    }
+
+    /// [`inverse_vector`](Self::inverse_vector) over lanes.
+    #[inline(always)]
+    pub fn inverse_vector_lanes<R: Real>(&self, v: LVec3<R>) -> LVec3<R> {
+        linear_lanes(&self.inv, v)
+    }
+
     /// Applies the transform to a surface normal: the inverse transpose of the linear part,
     /// so that normals stay perpendicular to transformed tangents under non-uniform scale.
     /// The result is not normalized.
@@ -279,6 +305,16 @@ impl std::ops::Mul for Transform {
             inv: rhs.inv * self.inv,
         }
     }
+}
+
+/// The linear part of `m` applied to lanes of vectors: x·v.x, then + y·v.y, then + z·v.z,
+/// as `DMat4::transform_vector3` adds them.
+#[inline(always)]
+fn linear_lanes<R: Real>(m: &Mat4, v: LVec3<R>) -> LVec3<R> {
+    let axis = |a: DVec4| LVec3::new(R::splat(a.x), R::splat(a.y), R::splat(a.z));
+    let res = axis(m.x_axis).scale(v.x);
+    let res = axis(m.y_axis).scale(v.y) + res;
+    axis(m.z_axis).scale(v.z) + res
 }
 
 #[inline]

@@ -1,538 +1,990 @@
-//! The packet kernel: eight camera samples of a row of pixels in flight per thread, each
-//! step advancing every live path by one segment, a finished path's lane refilled at once
-//! from the row's remaining (pixel, sample) jobs so that the lanes stay full.
+//! The packet kernel: eight camera samples of a tile in flight per thread, their paths kept
+//! as lanes (structure of arrays), each step advancing every live path by one segment, a
+//! finished path's lane refilled at once from a batch of eight camera rays made together.
 //!
 //! A step is the scalar integrator's vertex ([`integrator`](crate::integrator)) in phases,
-//! each over all lanes: intersection (one packet query for the eight rays,
-//! [`intersect_packet`](crate::geometry::SceneGeometry::intersect_packet)), emission and
-//! the vertex's frame (per lane); light samples (per lane); the material's value and
-//! density for every light sample (one call over eight lanes per material that has a lane
-//! model, `facette_bsdf::lanes::LaneBsdf`; the f64 model lane by lane otherwise); shadow
-//! rays (one packet query,
-//! [`occluded_packet`](crate::geometry::SceneGeometry::occluded_packet)); the material's
-//! samples (one call over eight lanes again); throughput, roulette and the next ray (per
-//! lane).
-//! The random numbers are the scalar integrator's, dimension for dimension, from the same
-//! sample streams, so the two kernels' images differ only by the f32 rounding of the lane
-//! models (and, where a rounding moves a path across a decision, by that path).
+//! each over all eight lanes: intersection (one packet query,
+//! [`intersect_lanes`](crate::geometry::SceneGeometry::intersect_lanes)) and the hit
+//! records ([`hit_lanes`](crate::geometry::SceneGeometry::hit_lanes)); emission; the
+//! shading frame; light samples; the materials' values and densities for them; shadow rays
+//! (one packet query); the materials' samples; throughput, roulette and the next rays.
 //!
-//! The packet queries find each lane's hit in f64, exactly as a one-ray query does
-//! (spheres four lanes at a time by their one-source test); lights, the camera, the
-//! sampler and the film stay f64 and per lane in this version. On x86-64 the step is
-//! compiled twice, for the baseline (SSE2: an 8-lane operation is two instructions) and
-//! for AVX2 + FMA, chosen at run time.
+//! Two lane types: the geometry — rays, hit points, normals, frames, spawned origins — is
+//! f64 in [`F64x8`] lanes, computed by the same one-source functions as the scalar
+//! integrator's (the sphere test and record, the camera, the spawning rule, the frame), so
+//! that a ray hits what the scalar integrator's ray hits; the shading — the directions in
+//! the local frame, the materials that have a lane model
+//! ([`LaneBsdf`](facette_bsdf::models::LaneBsdf)), light and path weights — is in the lane
+//! type `S`: [`F32x8`] in renders, [`F64x8`] in the test that finds the scalar integrator's
+//! image sample for sample. The random numbers are the scalar integrator's, dimension for
+//! dimension, drawn eight lanes at a time ([`SampleLanes`]).
+//!
+//! What has no lane form runs lane by lane inside the same step, through the scalar code:
+//! materials without a lane model (and every textured or glint material) through their
+//! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than a constant environment and point
+//! lights, environment maps, area-light emission, ray differentials. On x86-64 the kernel
+//! is compiled twice, for the baseline (SSE2: an 8-lane f32 operation is two instructions)
+//! and for AVX2 + FMA, chosen at run time.
 
-use crate::geometry::scene_geometry::PacketHit;
-use crate::geometry::{HitDetail, Ray, RayDifferential, SurfaceHit, Vec3};
-use crate::integrator::{
-    light_numbers, power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS,
-};
-use crate::lights::{Light, LightSample};
+use crate::geometry::bvh::lanes_of;
+use crate::geometry::ray::offset_origin_lanes;
+use crate::geometry::{HitLanes, LaneRays, RayDifferential, Vec3};
+use crate::image::ConstantEnvironment;
+use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
+use crate::lights::{Environment, Light};
 use crate::materials::MaterialBsdf;
 use crate::render::{CameraSampling, PixelSums};
+use crate::sampler::lanes::SampleLanes;
 use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
-use facette_bsdf::lanes::{F32x8, LVec3, Mask, Real};
-use facette_bsdf::math::Frame;
+use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LFrame, LVec3, M64x8, Mask, Real, U32x8};
+use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
+use facette_bsdf::models::LaneBsdf;
 use facette_bsdf::{BsdfContext, LobeFlags, Spectrum};
 use std::ops::Range;
 
 /// Paths in flight per thread.
 pub const LANES: usize = 8;
 
-/// One lane's path.
-struct Path {
-    /// The pixel's index in the row.
-    slot: usize,
-    stream: SampleStream,
-    ray: Ray,
-    rd: Option<RayDifferential>,
-    l: Spectrum,
-    beta: Spectrum,
-    delta_prev: bool,
-    prev_pdf: f64,
-    prev_p: Vec3,
-    eta_scale: f64,
+/// A set of lanes, lane `i` in bit `i`.
+type Lanes = u8;
+
+/// 8 f64 lanes: the kernel's geometry.
+type G = F64x8;
+
+#[inline(always)]
+fn to_s<S: Real>(x: G) -> S {
+    S::from_fn(|i| x.0[i])
+}
+
+#[inline(always)]
+fn to_g<S: Real>(x: S) -> G {
+    F64x8(std::array::from_fn(|i| x.lane(i)))
+}
+
+#[inline(always)]
+fn vec_s<S: Real>(v: LVec3<G>) -> LVec3<S> {
+    LVec3::new(to_s(v.x), to_s(v.y), to_s(v.z))
+}
+
+#[inline(always)]
+fn vec_g<S: Real>(v: LVec3<S>) -> LVec3<G> {
+    LVec3::new(to_g(v.x), to_g(v.y), to_g(v.z))
+}
+
+/// The mask of a lane set, in lanes of `R` (8 lanes).
+#[inline(always)]
+fn mask<R: Real>(set: Lanes) -> R::Mask {
+    R::Mask::from_fn(|i| set & (1 << i) != 0)
+}
+
+/// The lane set of a mask of 8 lanes.
+#[inline(always)]
+fn set_of<M: Mask>(m: M) -> Lanes {
+    (0..LANES).fold(0, |s, i| s | ((m.lane(i) as Lanes) << i))
+}
+
+/// `v` where the lane is in `set`, else `keep`.
+#[inline(always)]
+fn merge<R: Real>(set: Lanes, v: R, keep: R) -> R {
+    R::select(mask::<R>(set), v, keep)
+}
+
+/// A spectrum per lane: three channels of lanes.
+type Rgb<S> = [S; 3];
+
+#[inline(always)]
+fn rgb_splat<S: Real>(c: Spectrum) -> Rgb<S> {
+    std::array::from_fn(|k| S::splat(c[k]))
+}
+
+#[inline(always)]
+fn rgb_lane<S: Real>(c: &Rgb<S>, i: usize) -> Spectrum {
+    Spectrum([c[0].lane(i), c[1].lane(i), c[2].lane(i)])
+}
+
+/// Sets lane `i` of a spectrum to `v`.
+#[inline(always)]
+fn rgb_set<S: Real>(c: &mut Rgb<S>, i: usize, v: Spectrum) {
+    for k in 0..3 {
+        let old = c[k];
+        c[k] = S::from_fn(|j| if j == i { v[k] } else { old.lane(j) });
+    }
+}
+
+/// The eight paths of a thread.
+struct Paths<S: Real> {
+    /// Lanes holding a path.
+    live: Lanes,
+    /// Each lane's pixel, as an index into the tile's sums.
+    slot: [u32; LANES],
+    streams: [SampleStream; LANES],
+    samples: SampleLanes,
+    o: LVec3<G>,
+    d: LVec3<G>,
+    /// The camera ray's differentials (only where materials read footprints).
+    rd: [Option<RayDifferential>; LANES],
+    l: Rgb<S>,
+    beta: Rgb<S>,
+    delta_prev: Lanes,
+    prev_pdf: S,
+    prev_p: LVec3<G>,
+    eta_scale: S,
     /// Segments so far (the camera ray is segment 1).
-    segment: u32,
+    segment: U32x8,
 }
 
-/// What a lane's vertex has after intersection.
-struct Vertex<'s> {
-    hit: SurfaceHit,
-    frame: Frame,
-    wo: Vec3,
-    material: u32,
-    /// The f64 model of a material without a lane model.
-    scalar: Option<MaterialBsdf<'s>>,
-    flags: LobeFlags,
+/// Up to eight camera rays, made together, waiting for lanes.
+struct CameraBatch {
+    count: usize,
+    next: usize,
+    slot: [u32; LANES],
+    streams: [SampleStream; LANES],
+    samples: SampleLanes,
+    o: LVec3<G>,
+    d: LVec3<G>,
+    rd: [Option<RayDifferential>; LANES],
 }
 
-/// A light sample waiting for the material's value and density.
-struct LightCandidate {
-    ls: LightSample,
-    wi: Vec3,
-    p_select: f64,
-    /// f·|cos θ_i| and the material's density of wi.
-    f: Spectrum,
-    pdf: f64,
+/// The (pixel, sample) jobs of a tile, row by row; `stop` is asked before each row.
+struct Jobs<'a> {
+    xs: Range<usize>,
+    ys: Range<usize>,
+    chunk: &'a [u32],
+    /// The next job: row, column, sample.
+    y: usize,
+    x: usize,
+    k: usize,
+    rows_started: usize,
+    stop: &'a dyn Fn() -> bool,
+    ended: bool,
 }
 
-/// A material's sample for one lane.
-#[derive(Clone, Copy)]
-struct MaterialSample {
-    wi: Vec3,
-    weight: Spectrum,
-    pdf: f64,
-    eta: f64,
-    delta: bool,
-    transmitted: bool,
+impl Iterator for Jobs<'_> {
+    /// (x, y, sample index, slot).
+    type Item = (usize, usize, u32, u32);
+
+    #[inline]
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.ended || self.chunk.is_empty() || self.xs.is_empty() {
+            return None;
+        }
+        if self.k == self.chunk.len() {
+            self.k = 0;
+            self.x += 1;
+            if self.x == self.xs.end {
+                self.x = self.xs.start;
+                self.y += 1;
+            }
+        }
+        if self.x == self.xs.start && self.k == 0 {
+            // A new row.
+            if self.y >= self.ys.end || (self.stop)() {
+                self.ended = true;
+                return None;
+            }
+            self.rows_started += 1;
+        }
+        let s = self.chunk[self.k];
+        self.k += 1;
+        let slot = (self.y - self.ys.start) * self.xs.len() + (self.x - self.xs.start);
+        Some((self.x, self.y, s, slot as u32))
+    }
 }
 
-/// Renders every sample of `chunk` for the pixels `xs` of row `y` into `sums` (one entry
-/// per pixel), with the widest lanes this CPU runs.
-pub(crate) fn render_row(
-    scene: &Scene,
-    sampler: &PixelSampler,
-    cameras: CameraSampling,
-    strategy: Strategy,
-    (xs, y): (Range<usize>, usize),
-    chunk: &[u32],
-    sums: &mut [PixelSums],
-) {
+/// What the render loop gives the kernel.
+pub(crate) struct TileJob<'a> {
+    pub scene: &'a Scene,
+    pub sampler: &'a PixelSampler,
+    pub cameras: CameraSampling,
+    pub strategy: Strategy,
+    pub xs: Range<usize>,
+    pub ys: Range<usize>,
+    pub chunk: &'a [u32],
+    /// Asked before each row is started: stop there.
+    pub stop: &'a dyn Fn() -> bool,
+}
+
+/// Renders every sample of `job.chunk` for the tile's pixels into `sums` (row-major, one
+/// entry per pixel of the rows started), with the widest lanes this CPU runs; returns the
+/// number of rows started (a stop leaves the later rows out).
+pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has the features the function is compiled for.
-        unsafe { render_row_avx2(scene, sampler, cameras, strategy, (xs, y), chunk, sums) };
-        return;
+        return unsafe { render_tile_avx2(job, sums) };
     }
-    render_row_lanes::<F32x8>(scene, sampler, cameras, strategy, (xs, y), chunk, sums);
+    render_tile_lanes::<F32x8>(job, sums)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn render_row_avx2(
-    scene: &Scene,
-    sampler: &PixelSampler,
-    cameras: CameraSampling,
-    strategy: Strategy,
-    row: (Range<usize>, usize),
-    chunk: &[u32],
-    sums: &mut [PixelSums],
-) {
-    render_row_lanes::<F32x8>(scene, sampler, cameras, strategy, row, chunk, sums);
+unsafe fn render_tile_avx2(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
+    render_tile_lanes::<F32x8>(job, sums)
 }
 
-/// [`render_row`] with lane type `R` (the tests also run `f64` and `f32` lanes).
+/// [`render_tile`] with shading lanes `S` (8 lanes: `F32x8`, or `F64x8` in the tests).
 #[inline(always)]
-pub(crate) fn render_row_lanes<R: Real>(
-    scene: &Scene,
-    sampler: &PixelSampler,
+pub(crate) fn render_tile_lanes<S: Real>(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
+    debug_assert_eq!(S::LANES, LANES);
+    sums.clear();
+    sums.resize(job.xs.len() * job.ys.len(), PixelSums::default());
+    let mut jobs = Jobs {
+        xs: job.xs.clone(),
+        ys: job.ys.clone(),
+        chunk: job.chunk,
+        y: job.ys.start,
+        x: job.xs.start,
+        k: 0,
+        rows_started: 0,
+        stop: job.stop,
+        ended: false,
+    };
+    let placeholder = || job.sampler.stream(0, 0, 0);
+    let mut batch = CameraBatch {
+        count: 0,
+        next: 0,
+        slot: [0; LANES],
+        streams: std::array::from_fn(|_| placeholder()),
+        samples: SampleLanes::default(),
+        o: LVec3::zero(),
+        d: LVec3::zero(),
+        rd: [None; LANES],
+    };
+    let mut paths = Paths::<S> {
+        live: 0,
+        slot: [0; LANES],
+        streams: std::array::from_fn(|_| placeholder()),
+        samples: SampleLanes::default(),
+        o: LVec3::zero(),
+        d: LVec3::zero(),
+        rd: [None; LANES],
+        l: [S::zero(); 3],
+        beta: [S::one(); 3],
+        delta_prev: 0,
+        prev_pdf: S::zero(),
+        prev_p: LVec3::zero(),
+        eta_scale: S::one(),
+        segment: U32x8::splat(1),
+    };
+    let k = Kernel {
+        scene: job.scene,
+        sampler: job.sampler,
+        cameras: job.cameras,
+        strategy: job.strategy,
+    };
+    loop {
+        k.refill(&mut paths, &mut batch, &mut jobs);
+        if paths.live == 0 {
+            break;
+        }
+        k.step(&mut paths, sums);
+    }
+    sums.truncate(jobs.rows_started * job.xs.len());
+    jobs.rows_started
+}
+
+/// The scene and settings of a render.
+struct Kernel<'a> {
+    scene: &'a Scene,
+    sampler: &'a PixelSampler,
     cameras: CameraSampling,
     strategy: Strategy,
-    (xs, y): (Range<usize>, usize),
-    chunk: &[u32],
-    sums: &mut [PixelSums],
-) {
-    let x0 = xs.start;
-    let mut jobs = xs.flat_map(|x| chunk.iter().map(move |&s| (x, s)));
-    let mut lanes: [Option<Path>; LANES] = Default::default();
-    loop {
-        // Refill the empty lanes; stop when no job is left and every lane is empty.
-        for lane in lanes.iter_mut().filter(|l| l.is_none()) {
-            let Some((x, s)) = jobs.next() else { break };
-            let mut stream = sampler.stream(x, y, s as u64);
-            let (ray, rd) = cameras.ray(scene, &mut stream, x, y);
-            *lane = Some(Path {
-                slot: x - x0,
-                stream,
-                prev_p: ray.origin,
-                ray,
-                rd,
-                l: Spectrum::ZERO,
-                beta: Spectrum::ONE,
-                delta_prev: true,
-                prev_pdf: 0.0,
-                eta_scale: 1.0,
-                segment: 1,
-            });
+}
+
+/// One lane's material at a vertex.
+enum VertexBsdf<'s> {
+    None,
+    Lane(&'s LaneBsdf),
+    Scalar(MaterialBsdf<'s>),
+}
+
+impl Kernel<'_> {
+    /// Fills the empty lanes with camera rays, making a new batch when the last is used up.
+    #[inline(always)]
+    fn refill<S: Real>(&self, paths: &mut Paths<S>, batch: &mut CameraBatch, jobs: &mut Jobs) {
+        let mut filled: Lanes = 0;
+        for i in 0..LANES {
+            if paths.live & (1 << i) != 0 {
+                continue;
+            }
+            if batch.next == batch.count && !self.make_batch::<S>(batch, jobs) {
+                break;
+            }
+            let j = batch.next;
+            batch.next += 1;
+            paths.slot[i] = batch.slot[j];
+            std::mem::swap(&mut paths.streams[i], &mut batch.streams[j]);
+            paths.samples.set(i, self.sampler, &paths.streams[i]);
+            for (p, b) in [(&mut paths.o, &batch.o), (&mut paths.d, &batch.d)] {
+                p.x.0[i] = b.x.0[j];
+                p.y.0[i] = b.y.0[j];
+                p.z.0[i] = b.z.0[j];
+            }
+            paths.rd[i] = batch.rd[j];
+            filled |= 1 << i;
         }
-        if lanes.iter().all(Option::is_none) {
+        if filled == 0 {
             return;
         }
-        step::<R>(scene, strategy, &mut lanes, sums);
-    }
-}
-
-/// Ends lane `lane`'s path: its radiance goes to its pixel.
-#[inline]
-fn finish(lane: &mut Option<Path>, sums: &mut [PixelSums]) {
-    if let Some(p) = lane.take() {
-        sums[p.slot].add(p.l);
-    }
-}
-
-/// Advances every lane by one path segment.
-#[inline(always)]
-fn step<R: Real>(
-    scene: &Scene,
-    strategy: Strategy,
-    lanes: &mut [Option<Path>; LANES],
-    sums: &mut [PixelSums],
-) {
-    let rays: [Option<Ray>; LANES] = std::array::from_fn(|k| lanes[k].as_ref().map(|p| p.ray));
-    let hits = scene.geometry.intersect_packet(&rays);
-    let mut vertices: [Option<Vertex>; LANES] = Default::default();
-    for ((lane, vertex), hit) in lanes.iter_mut().zip(vertices.iter_mut()).zip(hits) {
-        let Some(path) = lane else { continue };
-        *vertex = arrive(scene, strategy, path, hit);
-        if vertex.is_none() {
-            finish(lane, sums);
-        }
-    }
-    // Light samples, then the materials' values and densities for them.
-    let mut lights: [Option<LightCandidate>; LANES] = Default::default();
-    for k in 0..LANES {
-        if let (Some(path), Some(v)) = (&mut lanes[k], &vertices[k]) {
-            if v.flags.has_smooth_part() && strategy != Strategy::BsdfOnly {
-                lights[k] = sample_light(scene, path, v);
+        paths.live |= filled;
+        paths.l = paths.l.map(|c| merge(filled, S::zero(), c));
+        paths.beta = paths.beta.map(|c| merge(filled, S::one(), c));
+        paths.delta_prev |= filled;
+        paths.prev_pdf = merge(filled, S::zero(), paths.prev_pdf);
+        paths.eta_scale = merge(filled, S::one(), paths.eta_scale);
+        paths.prev_p = LVec3::select(M64x8::from_bits(filled as u32), paths.o, paths.prev_p);
+        paths.segment = U32x8::from_fn(|i| {
+            if filled & (1 << i) != 0 {
+                1
+            } else {
+                paths.segment.lane(i)
             }
-        }
+        });
     }
-    eval_materials::<R>(scene, lanes, &vertices, &mut lights);
-    let shadows: [Option<Ray>; LANES] = std::array::from_fn(|k| match &lights[k] {
-        Some(c) if lanes[k].is_some() && !c.f.is_black() => Some(c.ls.shadow),
-        _ => None,
-    });
-    let occluded = scene.geometry.occluded_packet(&shadows);
-    for k in 0..LANES {
-        if let (Some(path), Some(c), Some(_)) = (&mut lanes[k], &lights[k], &shadows[k]) {
-            if occluded & (1 << k) == 0 {
-                let pl = c.p_select * c.ls.pdf;
-                let w = if c.ls.delta || strategy == Strategy::NeeOnly {
-                    1.0
-                } else {
-                    power_heuristic(pl, c.pdf)
-                };
-                path.l += path.beta * c.f * c.ls.radiance * (w / pl);
-            }
-        }
-    }
-    // The materials' samples, then the next segment.
-    let samples = sample_materials::<R>(scene, lanes, &vertices);
-    for k in 0..LANES {
-        let (Some(path), Some(v)) = (&mut lanes[k], &vertices[k]) else {
-            continue;
-        };
-        if !continue_path(scene, path, v, samples[k]) {
-            finish(&mut lanes[k], sums);
-        }
-    }
-}
 
-/// Adds what the lane's ray sees emitted at its hit `hit` (or in the environment where it
-/// has none); the vertex to shade, or `None` where the path ends.
-#[inline]
-fn arrive<'s>(
-    scene: &'s Scene,
-    strategy: Strategy,
-    path: &mut Path,
-    hit: Option<PacketHit>,
-) -> Option<Vertex<'s>> {
-    let ray = path.ray;
-    let mis = |path: &Path, pl: f64| match strategy {
-        _ if path.delta_prev => 1.0,
-        Strategy::Mis => power_heuristic(path.prev_pdf, pl),
-        Strategy::NeeOnly => 0.0,
-        Strategy::BsdfOnly => 1.0,
-    };
-    let Some(hit) = hit else {
-        if let Some(env) = scene.environment {
-            if let Light::Environment(e) = &scene.lights[env as usize] {
-                let pl = scene.selector.probability(env as usize) * e.pdf(ray.dir);
-                path.l += path.beta * e.eval(ray.dir) * mis(path, pl);
-            }
+    /// The camera rays of the next (up to) eight jobs; `false` when no job is left.
+    #[inline(always)]
+    fn make_batch<S: Real>(&self, batch: &mut CameraBatch, jobs: &mut Jobs) -> bool {
+        let mut px = [0.0; LANES];
+        let mut py = [0.0; LANES];
+        let mut n = 0;
+        for (x, y, s, slot) in jobs.by_ref().take(LANES) {
+            batch.streams[n] = self.sampler.stream(x, y, s as u64);
+            batch.samples.set(n, self.sampler, &batch.streams[n]);
+            batch.slot[n] = slot;
+            px[n] = x as f64 + 0.5;
+            py[n] = y as f64 + 0.5;
+            n += 1;
         }
-        return None;
-    };
-    let mut hit = scene
-        .geometry
-        .packet_hit_record(&ray, hit, HitDetail::Shading);
-    if let Some(li) = scene.shape_light[hit.shape as usize] {
-        let light = &scene.lights[li as usize];
-        let le = light.emitted(hit.ng, -ray.dir);
-        if !le.is_black() {
-            let pl = scene.selector.probability(li as usize)
-                * light.pdf_area_hit(&scene.geometry, path.prev_p, hit.p, hit.ng, hit.prim);
-            path.l += path.beta * le * mis(path, pl);
-        }
-    }
-    if path.segment >= scene.integrator.max_depth {
-        return None;
-    }
-    let material = scene.shape_material[hit.shape as usize];
-    let m = &scene.materials[material as usize];
-    let (scalar, flags) = match m.lane_bsdf() {
-        Some(lane) => (None, lane.flags()),
-        None => {
-            let mut derivs = [0.0; 4];
-            if m.reads_surface_details() {
-                scene.geometry.complete_hit(&mut hit);
-                if let (Some(d), 1) = (&path.rd, path.segment) {
-                    derivs = hit.uv_derivatives(d);
-                }
-            }
-            let bsdf = m.bsdf(hit.uv, derivs)?;
-            let flags = bsdf.flags();
-            (Some(bsdf), flags)
-        }
-    };
-    let frame = hit.shading_frame();
-    Some(Vertex {
-        wo: frame.to_local(-ray.dir),
-        hit,
-        frame,
-        material,
-        scalar,
-        flags,
-    })
-}
-
-/// The first dimension of the lane's current vertex block.
-#[inline]
-fn block(path: &Path) -> u32 {
-    CAMERA_DIMENSIONS + (path.segment - 1) * VERTEX_DIMENSIONS
-}
-
-/// One light sample from the vertex's light-selection and light-position numbers; an f64
-/// material is evaluated at once.
-#[inline]
-fn sample_light(scene: &Scene, path: &mut Path, v: &Vertex) -> Option<LightCandidate> {
-    let first = block(path);
-    let (u_select, u) = light_numbers(scene, &mut path.stream, first);
-    let (k, p_select) = scene.selector.select(u_select)?;
-    let ls = scene.lights[k].sample(&scene.geometry, v.hit.p, v.hit.ng, u)?;
-    if ls.radiance.is_black() {
-        return None;
-    }
-    let wi = v.frame.to_local(ls.wi);
-    if !(ls.wi.dot(v.hit.ng) * wi.z > 0.0) {
-        return None;
-    }
-    let mut c = LightCandidate {
-        ls,
-        wi,
-        p_select,
-        f: Spectrum::ZERO,
-        pdf: 0.0,
-    };
-    if let Some(bsdf) = &v.scalar {
-        let ctx = BsdfContext::RADIANCE;
-        c.f = bsdf.eval(v.wo, wi, &ctx, path.stream.rng()) * wi.z.abs();
-        if !c.f.is_black() {
-            c.pdf = bsdf.pdf(v.wo, wi, &ctx);
-        }
-    }
-    Some(c)
-}
-
-/// The lanes of `vertices` whose material is `material` and that satisfy `want`, as a
-/// bit set.
-#[inline]
-fn lanes_of(
-    vertices: &[Option<Vertex>; LANES],
-    material: u32,
-    want: impl Fn(usize) -> bool,
-) -> u32 {
-    let mut set = 0;
-    for (k, v) in vertices.iter().enumerate() {
-        if matches!(v, Some(v) if v.material == material && v.scalar.is_none()) && want(k) {
-            set |= 1 << k;
-        }
-    }
-    set
-}
-
-/// Each lane-model material present among `set`'s lanes once, with its lanes.
-#[inline]
-fn material_groups<'a>(
-    vertices: &'a [Option<Vertex<'_>>; LANES],
-    set: u32,
-) -> impl Iterator<Item = (u32, u32)> + 'a {
-    let mut left = set;
-    std::iter::from_fn(move || {
-        let k = (0..LANES).find(|k| left & (1 << k) != 0)?;
-        let material = vertices[k].as_ref()?.material;
-        let group = left & lanes_of(vertices, material, |_| true);
-        left &= !group;
-        Some((material, group))
-    })
-}
-
-/// A direction per lane, (0, 0, 1) where the lane is not in `set` (a harmless input).
-#[inline(always)]
-fn gather<R: Real>(base: usize, set: u32, dir: impl Fn(usize) -> Vec3) -> LVec3<R> {
-    LVec3::from_fn(|i| {
-        if set & (1 << (base + i)) != 0 {
-            dir(base + i)
-        } else {
-            Vec3::Z
-        }
-    })
-}
-
-/// The lane models' values and densities for the light samples.
-#[inline(always)]
-fn eval_materials<R: Real>(
-    scene: &Scene,
-    lanes: &[Option<Path>; LANES],
-    vertices: &[Option<Vertex>; LANES],
-    lights: &mut [Option<LightCandidate>; LANES],
-) {
-    let waiting = (0..LANES).fold(0, |set, k| {
-        let lane_model = matches!(&vertices[k], Some(v) if v.scalar.is_none());
-        set | (((lane_model && lights[k].is_some() && lanes[k].is_some()) as u32) << k)
-    });
-    for (material, group) in material_groups(vertices, waiting) {
-        let model = scene.materials[material as usize]
-            .lane_bsdf()
-            .expect("a lane-model group");
-        for base in (0..LANES).step_by(R::LANES) {
-            if group >> base & ((1 << R::LANES) - 1) == 0 {
-                continue;
-            }
-            let wo = gather::<R>(base, group, |k| {
-                vertices[k].as_ref().map_or(Vec3::Z, |v| v.wo)
-            });
-            let wi = gather::<R>(base, group, |k| {
-                lights[k].as_ref().map_or(Vec3::Z, |c| c.wi)
-            });
-            let (f, pdf) = model.eval_pdf(wo, wi);
-            for i in 0..R::LANES {
-                let k = base + i;
-                if group & (1 << k) == 0 {
-                    continue;
-                }
-                if let Some(c) = &mut lights[k] {
-                    let cos = c.wi.z.abs();
-                    c.f = Spectrum([f[0].lane(i) * cos, f[1].lane(i) * cos, f[2].lane(i) * cos]);
-                    c.pdf = pdf.lane(i);
-                }
-            }
-        }
-    }
-}
-
-/// Every live lane's material sample: the lane models in one call per material, the f64
-/// models lane by lane.
-#[inline(always)]
-fn sample_materials<R: Real>(
-    scene: &Scene,
-    lanes: &mut [Option<Path>; LANES],
-    vertices: &[Option<Vertex>; LANES],
-) -> [Option<MaterialSample>; LANES] {
-    let mut out: [Option<MaterialSample>; LANES] = [None; LANES];
-    // The lobe number and the direction numbers of each vertex.
-    let mut numbers = [[0.0; 3]; LANES];
-    let ctx = BsdfContext::RADIANCE;
-    let mut lane_set = 0;
-    for k in 0..LANES {
-        let (Some(path), Some(v)) = (&mut lanes[k], &vertices[k]) else {
-            continue;
-        };
-        let first = block(path) + 3;
-        match &v.scalar {
-            Some(bsdf) => {
-                let mut source = PrefixedSource::new(&mut path.stream, first);
-                out[k] = bsdf
-                    .sample(v.wo, &ctx, &mut source)
-                    .map(|s| MaterialSample {
-                        wi: s.wi,
-                        weight: s.weight,
-                        pdf: s.pdf,
-                        eta: s.eta,
-                        delta: s.lobe.is_delta(),
-                        transmitted: s.lobe.intersects(LobeFlags::TRANSMISSION),
-                    });
-            }
-            None => {
-                // The lane model says whether it reads a lobe number (one-lobe models do
-                // not: the dimension is left undrawn).
-                let reads_lobe = scene.materials[v.material as usize]
-                    .lane_bsdf()
-                    .is_some_and(|m| m.reads_lobe_number());
-                path.stream.set_dimension(first);
-                let lobe = path.stream.get_1d_where(reads_lobe);
-                let dir = path.stream.get_2d();
-                numbers[k] = [lobe, dir.x, dir.y];
-                lane_set |= 1 << k;
-            }
-        }
-    }
-    for (material, group) in material_groups(vertices, lane_set) {
-        let model = scene.materials[material as usize]
-            .lane_bsdf()
-            .expect("a lane-model group");
-        for base in (0..LANES).step_by(R::LANES) {
-            if group >> base & ((1 << R::LANES) - 1) == 0 {
-                continue;
-            }
-            let wo = gather::<R>(base, group, |k| {
-                vertices[k].as_ref().map_or(Vec3::Z, |v| v.wo)
-            });
-            let u = |j: usize| R::from_fn(|i| numbers[base + i][j]);
-            let s = model.sample(wo, u(0), u(1), u(2));
-            for i in 0..R::LANES {
-                let k = base + i;
-                if group & (1 << k) != 0 && s.ok.lane(i) {
-                    out[k] = Some(MaterialSample {
-                        wi: s.wi.lane(i),
-                        weight: Spectrum([
-                            s.weight[0].lane(i),
-                            s.weight[1].lane(i),
-                            s.weight[2].lane(i),
-                        ]),
-                        pdf: s.pdf.lane(i),
-                        eta: s.eta.lane(i),
-                        delta: false,
-                        transmitted: s.transmitted.lane(i),
-                    });
-                }
-            }
-        }
-    }
-    out
-}
-
-/// Takes the material's sample: throughput, Russian roulette and the next ray. `false`
-/// where the path ends.
-#[inline]
-fn continue_path(scene: &Scene, path: &mut Path, v: &Vertex, s: Option<MaterialSample>) -> bool {
-    let Some(s) = s else { return false };
-    // f32 lanes return directions of length 1 ± 1e-7: the f64 ray needs a unit one.
-    let wi = v.frame.to_world(s.wi).normalize_or_zero();
-    if !(wi.dot(v.hit.ng) * s.wi.z > 0.0) || s.weight.is_black() {
-        return false;
-    }
-    path.beta *= s.weight;
-    path.delta_prev = s.delta;
-    path.prev_pdf = s.pdf;
-    path.prev_p = v.hit.p;
-    if s.transmitted {
-        path.eta_scale *= s.eta * s.eta;
-    }
-    let rr_dimension = block(path) + 6;
-    path.segment += 1;
-    if path.segment > scene.integrator.rr_depth {
-        let q = (path.beta.max_component() * path.eta_scale).min(0.95);
-        path.stream.set_dimension(rr_dimension);
-        if !(q > 0.0) || path.stream.get_1d() >= q {
+        batch.count = n;
+        batch.next = 0;
+        if n == 0 {
             return false;
         }
-        path.beta /= q;
+        let active: Lanes = ((1u32 << n) - 1) as Lanes;
+        let scene = self.scene;
+        // The filter offset (dimensions 0, 1), then the lens position (2, 3) where read.
+        let (u0, u1) = self.sampler.get_lanes::<S>(
+            &batch.samples,
+            &mut batch.streams,
+            U32x8::splat(0),
+            active,
+            true,
+        );
+        let (ox, oy) = scene.film.filter.sample_lanes(u0, u1);
+        let fx = F64x8(px) + to_g(ox);
+        let fy = F64x8(py) + to_g(oy);
+        let lens = if scene.camera.has_lens() {
+            let (l0, l1) = self.sampler.get_lanes::<S>(
+                &batch.samples,
+                &mut batch.streams,
+                U32x8::splat(2),
+                active,
+                true,
+            );
+            (to_g(l0), to_g(l1))
+        } else {
+            (G::splat(0.5), G::splat(0.5))
+        };
+        if self.cameras.footprints {
+            for i in 0..n {
+                let lens = crate::geometry::Vec2::new(lens.0 .0[i], lens.1 .0[i]);
+                let (ray, rd) = scene.camera.generate_ray(fx.0[i], fy.0[i], lens);
+                for (v, w) in [(&mut batch.o, ray.origin), (&mut batch.d, ray.dir)] {
+                    v.x.0[i] = w.x;
+                    v.y.0[i] = w.y;
+                    v.z.0[i] = w.z;
+                }
+                batch.rd[i] = Some(rd.scaled(&ray, self.cameras.diff_scale));
+            }
+        } else {
+            (batch.o, batch.d) = scene.camera.primary_rays(fx, fy, lens);
+            batch.rd = [None; LANES];
+        }
+        true
     }
-    path.ray = v.hit.spawn_ray(wi);
-    true
+
+    /// MIS weight of emission found by the BSDF sample of the previous vertex, whose
+    /// density was `prev_pdf`, against light sampling's density `pl`.
+    #[inline(always)]
+    fn emission_weight<S: Real>(&self, delta_prev: Lanes, prev_pdf: S, pl: S) -> S {
+        let w = match self.strategy {
+            Strategy::Mis => power_heuristic_lanes(prev_pdf, pl),
+            Strategy::NeeOnly => S::zero(),
+            Strategy::BsdfOnly => S::one(),
+        };
+        merge(delta_prev, S::one(), w)
+    }
+
+    /// Adds `beta · le · w` to the lanes of `set`.
+    #[inline(always)]
+    fn add_radiance<S: Real>(paths: &mut Paths<S>, set: Lanes, le: &Rgb<S>, w: S) {
+        for c in 0..3 {
+            paths.l[c] = merge(set, paths.l[c] + paths.beta[c] * le[c] * w, paths.l[c]);
+        }
+    }
+
+    /// Ends the paths of `set`: their radiance goes to their pixels.
+    #[inline(always)]
+    fn finish<S: Real>(paths: &mut Paths<S>, set: Lanes, sums: &mut [PixelSums]) {
+        for i in lanes_of(set) {
+            sums[paths.slot[i] as usize].add(rgb_lane(&paths.l, i));
+        }
+        paths.live &= !set;
+    }
+
+    /// Advances every live lane by one path segment.
+    #[inline(always)]
+    fn step<S: Real>(&self, paths: &mut Paths<S>, sums: &mut [PixelSums]) {
+        let scene = self.scene;
+        let rays = LaneRays::new(paths.o, paths.d, G::splat(f64::INFINITY), paths.live);
+        let hits = scene.geometry.intersect_lanes(&rays);
+        let hit_set: Lanes = (0..LANES).fold(0, |s, i| s | ((hits[i].is_some() as Lanes) << i));
+        let missed = paths.live & !hit_set;
+        if missed != 0 {
+            self.environment(paths, missed);
+            Self::finish(paths, missed, sums);
+        }
+        if paths.live == 0 {
+            return;
+        }
+        let hl = scene.geometry.hit_lanes(&rays, &hits);
+        self.area_emission(paths, &hl);
+        let deep = set_of(paths.segment.ge_splat(scene.integrator.max_depth)) & paths.live;
+        if deep != 0 {
+            Self::finish(paths, deep, sums);
+        }
+        if paths.live == 0 {
+            return;
+        }
+        // The materials.
+        let mut bsdfs: [VertexBsdf; LANES] = std::array::from_fn(|_| VertexBsdf::None);
+        let mut smooth: Lanes = 0;
+        let mut no_bsdf: Lanes = 0;
+        for i in lanes_of(paths.live) {
+            let material = scene.shape_material[hl.shape[i] as usize] as usize;
+            let m = &scene.materials[material];
+            bsdfs[i] = match m.lane_bsdf() {
+                Some(lane) => VertexBsdf::Lane(lane),
+                None => {
+                    let mut hit = hl.surface_hit(i);
+                    let mut derivs = [0.0; 4];
+                    if m.reads_surface_details() {
+                        scene.geometry.complete_hit(&mut hit);
+                        if let (Some(d), 1) = (&paths.rd[i], paths.segment.lane(i)) {
+                            derivs = hit.uv_derivatives(d);
+                        }
+                    }
+                    match m.bsdf(hit.uv, derivs) {
+                        Some(b) => VertexBsdf::Scalar(b),
+                        None => {
+                            no_bsdf |= 1 << i;
+                            continue;
+                        }
+                    }
+                }
+            };
+            let flags = match &bsdfs[i] {
+                VertexBsdf::Lane(l) => l.flags(),
+                VertexBsdf::Scalar(b) => b.flags(),
+                VertexBsdf::None => LobeFlags::NONE,
+            };
+            if flags.has_smooth_part() {
+                smooth |= 1 << i;
+            }
+        }
+        if no_bsdf != 0 {
+            Self::finish(paths, no_bsdf, sums);
+        }
+        let frame = LFrame::from_normal_tangent(hl.ns, hl.dpdu);
+        let wo = vec_s::<S>(frame.to_local(-paths.d));
+        let block = paths
+            .segment
+            .wrapping_add(U32x8::splat(u32::MAX))
+            .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
+            .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
+        if self.strategy != Strategy::BsdfOnly {
+            self.next_event(paths, &hl, &frame, wo, &bsdfs, smooth & paths.live, block);
+        }
+        self.continue_paths(paths, &hl, &frame, wo, &bsdfs, block, sums);
+    }
+
+    /// Emission seen by the rays of `missed` leaving the scene.
+    #[inline(always)]
+    fn environment<S: Real>(&self, paths: &mut Paths<S>, missed: Lanes) {
+        let scene = self.scene;
+        let Some(env) = scene.environment else { return };
+        let Light::Environment(e) = &scene.lights[env as usize] else {
+            return;
+        };
+        let p_select = scene.selector.probability(env as usize);
+        if let Environment::Constant(c) = e {
+            // Every valid direction sees the same radiance, at the density 1/4π.
+            let valid = paths.d.length_squared().gt(G::zero())
+                & paths.d.x.is_finite()
+                & paths.d.y.is_finite()
+                & paths.d.z.is_finite();
+            let set = missed & set_of(valid);
+            let pl = S::splat(p_select * constant_pdf(c));
+            let w = self.emission_weight(paths.delta_prev, paths.prev_pdf, pl);
+            Self::add_radiance(paths, set, &rgb_splat(c.mean_radiance()), w);
+            return;
+        }
+        for i in lanes_of(missed) {
+            let dir = paths.d.lane(i);
+            let le = e.eval(dir);
+            if le.is_black() {
+                continue;
+            }
+            let pl = p_select * e.pdf(dir);
+            let w = self
+                .emission_weight(
+                    paths.delta_prev & (1 << i),
+                    S::splat(paths.prev_pdf.lane(i)),
+                    S::splat(pl),
+                )
+                .lane(i);
+            let beta = rgb_lane(&paths.beta, i);
+            let l = rgb_lane(&paths.l, i) + beta * le * w;
+            rgb_set(&mut paths.l, i, l);
+        }
+    }
+
+    /// Emission of the area lights the hits of `hl` lie on.
+    #[inline(always)]
+    fn area_emission<S: Real>(&self, paths: &mut Paths<S>, hl: &HitLanes) {
+        let scene = self.scene;
+        for i in lanes_of(hl.lanes & paths.live) {
+            let Some(li) = scene.shape_light[hl.shape[i] as usize] else {
+                continue;
+            };
+            let light = &scene.lights[li as usize];
+            let (ng, dir) = (hl.ng.lane(i), paths.d.lane(i));
+            let le = light.emitted(ng, -dir);
+            if le.is_black() {
+                continue;
+            }
+            let pl = scene.selector.probability(li as usize)
+                * light.pdf_area_hit(
+                    &scene.geometry,
+                    paths.prev_p.lane(i),
+                    hl.p.lane(i),
+                    ng,
+                    hl.prim[i],
+                );
+            let w = match self.strategy {
+                _ if paths.delta_prev & (1 << i) != 0 => 1.0,
+                Strategy::Mis => power_heuristic(paths.prev_pdf.lane(i), pl),
+                Strategy::NeeOnly => 0.0,
+                Strategy::BsdfOnly => 1.0,
+            };
+            let l = rgb_lane(&paths.l, i) + rgb_lane(&paths.beta, i) * le * w;
+            rgb_set(&mut paths.l, i, l);
+        }
+    }
+
+    /// Next-event estimation for the lanes of `set`: a light sample each, the materials'
+    /// values and densities, one packet of shadow rays.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn next_event<S: Real>(
+        &self,
+        paths: &mut Paths<S>,
+        hl: &HitLanes,
+        frame: &LFrame<G>,
+        wo: LVec3<S>,
+        bsdfs: &[VertexBsdf; LANES],
+        set: Lanes,
+        block: U32x8,
+    ) {
+        if set == 0 {
+            return;
+        }
+        let scene = self.scene;
+        let selector = &scene.selector;
+        let u_select = if selector.reads_selection_number() {
+            to_g(
+                self.sampler
+                    .get_lanes::<S>(&paths.samples, &mut paths.streams, block, set, false)
+                    .0,
+            )
+        } else {
+            G::splat(0.5)
+        };
+        let (u0, u1) = if selector.reads_position_numbers() {
+            self.sampler.get_lanes::<S>(
+                &paths.samples,
+                &mut paths.streams,
+                block.wrapping_add(U32x8::splat(1)),
+                set,
+                true,
+            )
+        } else {
+            (S::splat(0.5), S::splat(0.5))
+        };
+        // The light of each lane.
+        let mut light_of = [usize::MAX; LANES];
+        let mut p_select = [0.0; LANES];
+        let mut chosen: Lanes = 0;
+        for i in lanes_of(set) {
+            if let Some((k, p)) = selector.select(u_select.0[i]) {
+                light_of[i] = k;
+                p_select[i] = p;
+                chosen |= 1 << i;
+            }
+        }
+        // Light samples: direction (world), radiance, density, the shadow ray's origin and
+        // length, delta lights.
+        let mut wi = LVec3::<G>::zero();
+        let mut le: Rgb<S> = [S::zero(); 3];
+        let mut pdf_light = S::zero();
+        let mut shadow_o = LVec3::<G>::zero();
+        let mut shadow_d = LVec3::<G>::zero();
+        let mut shadow_t = G::zero();
+        let mut delta: Lanes = 0;
+        let mut sampled: Lanes = 0;
+        let mut todo = chosen;
+        while todo != 0 {
+            let k = light_of[todo.trailing_zeros() as usize];
+            let group = lanes_of(todo)
+                .filter(|&i| light_of[i] == k)
+                .fold(0, |s, i| s | (1 << i));
+            todo &= !group;
+            let m = M64x8::from_bits(group as u32);
+            match &scene.lights[k] {
+                Light::Environment(Environment::Constant(c)) if !c.mean_radiance().is_black() => {
+                    let dir = vec_g(square_to_uniform_sphere_lanes(u0, u1));
+                    // Ray::spawn: offset along the normal, the direction made unit.
+                    let o = offset_origin_lanes(hl.p, hl.ng, dir);
+                    wi = LVec3::select(m, dir, wi);
+                    shadow_o = LVec3::select(m, o, shadow_o);
+                    shadow_d = LVec3::select(m, dir.normalize(), shadow_d);
+                    shadow_t = G::select(m, G::splat(f64::INFINITY), shadow_t);
+                    let radiance = rgb_splat::<S>(c.mean_radiance());
+                    for ch in 0..3 {
+                        le[ch] = merge(group, radiance[ch], le[ch]);
+                    }
+                    pdf_light = merge(group, S::splat(constant_pdf(c)), pdf_light);
+                    sampled |= group;
+                }
+                Light::Point {
+                    position,
+                    intensity,
+                } => {
+                    let target = LVec3::splat(*position);
+                    let to = target - hl.p;
+                    let dist2 = to.length_squared();
+                    let dir = to.scale(G::one() / dist2.sqrt());
+                    let ok = group & set_of(dist2.gt(G::zero()));
+                    // Ray::spawn_to: offset towards the light, then the segment to it.
+                    let o = offset_origin_lanes(hl.p, hl.ng, to);
+                    let seg = target - o;
+                    let len = seg.length_squared().sqrt();
+                    let seg_ok = len.gt(G::zero()) & len.is_finite();
+                    let m = M64x8::from_bits(ok as u32);
+                    wi = LVec3::select(m, dir, wi);
+                    shadow_o = LVec3::select(m, o, shadow_o);
+                    shadow_d = LVec3::select(m, seg.scale(G::one() / len), shadow_d);
+                    shadow_t = G::select(m, G::select(seg_ok, len, G::zero()), shadow_t);
+                    let inv = to_s::<S>(G::one() / dist2);
+                    for ch in 0..3 {
+                        le[ch] = merge(ok, S::splat(intensity[ch]) * inv, le[ch]);
+                    }
+                    pdf_light = merge(ok, S::one(), pdf_light);
+                    delta |= ok;
+                    sampled |= ok;
+                }
+                light => {
+                    for i in lanes_of(group) {
+                        let u = crate::geometry::Vec2::new(u0.lane(i), u1.lane(i));
+                        let Some(ls) =
+                            light.sample(&scene.geometry, hl.p.lane(i), hl.ng.lane(i), u)
+                        else {
+                            continue;
+                        };
+                        if ls.radiance.is_black() {
+                            continue;
+                        }
+                        let put = |v: &mut LVec3<G>, w: Vec3| {
+                            v.x.0[i] = w.x;
+                            v.y.0[i] = w.y;
+                            v.z.0[i] = w.z;
+                        };
+                        put(&mut wi, ls.wi);
+                        put(&mut shadow_o, ls.shadow.origin);
+                        put(&mut shadow_d, ls.shadow.dir);
+                        shadow_t.0[i] = ls.shadow.t_max;
+                        rgb_set(&mut le, i, ls.radiance);
+                        pdf_light = S::from_fn(|j| if j == i { ls.pdf } else { pdf_light.lane(j) });
+                        if ls.delta {
+                            delta |= 1 << i;
+                        }
+                        sampled |= 1 << i;
+                    }
+                }
+            }
+        }
+        let wi_local_g = frame.to_local(wi);
+        let side = set_of((wi.dot(hl.ng) * wi_local_g.z).gt(G::zero()));
+        let mut candidates = sampled & side;
+        if candidates == 0 {
+            return;
+        }
+        let wi_local = vec_s::<S>(wi_local_g);
+        // The materials' values (f·|cos θ_i|) and densities.
+        let mut f: Rgb<S> = [S::zero(); 3];
+        let mut pdf = S::zero();
+        self.eval_materials(paths, bsdfs, wo, wi_local, candidates, &mut f, &mut pdf);
+        let black = set_of(f[0].eq(S::zero()) & f[1].eq(S::zero()) & f[2].eq(S::zero()));
+        candidates &= !black;
+        if candidates == 0 {
+            return;
+        }
+        let shadows = LaneRays::new(shadow_o, shadow_d, shadow_t, candidates);
+        let visible = candidates & !scene.geometry.occluded_lanes(&shadows);
+        if visible == 0 {
+            return;
+        }
+        let pl = S::from_fn(|i| p_select[i]) * pdf_light;
+        let w = if self.strategy == Strategy::NeeOnly {
+            S::one()
+        } else {
+            merge(delta, S::one(), power_heuristic_lanes(pl, pdf))
+        };
+        let scale = w / pl;
+        for c in 0..3 {
+            let add = paths.l[c] + paths.beta[c] * (f[c] * le[c] * scale);
+            paths.l[c] = merge(visible, add, paths.l[c]);
+        }
+    }
+
+    /// The materials' `f·|cos θ_i|` and densities for the pairs (wo, wi) of `set`: one lane
+    /// call per lane model present, the f64 models lane by lane.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn eval_materials<S: Real>(
+        &self,
+        paths: &mut Paths<S>,
+        bsdfs: &[VertexBsdf; LANES],
+        wo: LVec3<S>,
+        wi: LVec3<S>,
+        set: Lanes,
+        f: &mut Rgb<S>,
+        pdf: &mut S,
+    ) {
+        let cos = wi.z.abs();
+        let mut todo = set;
+        while todo != 0 {
+            let first = todo.trailing_zeros() as usize;
+            match &bsdfs[first] {
+                VertexBsdf::Lane(model) => {
+                    let group = lanes_of(todo)
+                        .filter(|&i| matches!(&bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, *model)))
+                        .fold(0, |s, i| s | (1 << i));
+                    todo &= !group;
+                    let (v, p) = model.eval_pdf(wo, wi);
+                    for c in 0..3 {
+                        f[c] = merge(group, v[c] * cos, f[c]);
+                    }
+                    *pdf = merge(group, p, *pdf);
+                }
+                VertexBsdf::Scalar(bsdf) => {
+                    todo &= !(1 << first);
+                    let ctx = BsdfContext::RADIANCE;
+                    let (o, i) = (wo.lane(first), wi.lane(first));
+                    let v = bsdf.eval(o, i, &ctx, paths.streams[first].rng()) * i.z.abs();
+                    if !v.is_black() {
+                        rgb_set(f, first, v);
+                        let p = bsdf.pdf(o, i, &ctx);
+                        *pdf = S::from_fn(|j| if j == first { p } else { pdf.lane(j) });
+                    }
+                }
+                VertexBsdf::None => todo &= !(1 << first),
+            }
+        }
+    }
+
+    /// The materials' samples, throughput, Russian roulette and the next rays; the paths
+    /// that end are finished.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn continue_paths<S: Real>(
+        &self,
+        paths: &mut Paths<S>,
+        hl: &HitLanes,
+        frame: &LFrame<G>,
+        wo: LVec3<S>,
+        bsdfs: &[VertexBsdf; LANES],
+        block: U32x8,
+        sums: &mut [PixelSums],
+    ) {
+        let live = paths.live;
+        let mut wi = LVec3::<S>::zero();
+        let mut weight: Rgb<S> = [S::zero(); 3];
+        let mut pdf = S::zero();
+        let mut eta = S::one();
+        let mut delta: Lanes = 0;
+        let mut transmitted: Lanes = 0;
+        let mut ok: Lanes = 0;
+        // Lane models: the lobe number where a model reads it, the direction pair.
+        let lane_set = lanes_of(live)
+            .filter(|&i| matches!(bsdfs[i], VertexBsdf::Lane(_)))
+            .fold(0, |s, i| s | (1 << i));
+        if lane_set != 0 {
+            let lobe_set = lanes_of(lane_set)
+                .filter(|&i| matches!(bsdfs[i], VertexBsdf::Lane(m) if m.reads_lobe_number()))
+                .fold(0, |s, i| s | (1 << i));
+            let u_lobe = if lobe_set != 0 {
+                self.sampler
+                    .get_lanes::<S>(
+                        &paths.samples,
+                        &mut paths.streams,
+                        block.wrapping_add(U32x8::splat(3)),
+                        lobe_set,
+                        false,
+                    )
+                    .0
+            } else {
+                S::splat(0.5)
+            };
+            let (u0, u1) = self.sampler.get_lanes::<S>(
+                &paths.samples,
+                &mut paths.streams,
+                block.wrapping_add(U32x8::splat(4)),
+                lane_set,
+                true,
+            );
+            let mut todo = lane_set;
+            while todo != 0 {
+                let VertexBsdf::Lane(model) = &bsdfs[todo.trailing_zeros() as usize] else {
+                    unreachable!("a lane-model lane");
+                };
+                let group = lanes_of(todo)
+                    .filter(
+                        |&i| matches!(&bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, *model)),
+                    )
+                    .fold(0, |s, i| s | (1 << i));
+                todo &= !group;
+                let s = model.sample(wo, u_lobe, u0, u1);
+                let m = mask::<S>(group);
+                wi = LVec3::select(m, s.wi, wi);
+                for c in 0..3 {
+                    weight[c] = merge(group, s.weight[c], weight[c]);
+                }
+                pdf = merge(group, s.pdf, pdf);
+                eta = merge(group, s.eta, eta);
+                transmitted |= group & set_of(s.transmitted);
+                ok |= group & set_of(s.ok);
+            }
+        }
+        // The f64 models, lane by lane, from their vertex's dimensions then the free stream.
+        let ctx = BsdfContext::RADIANCE;
+        for i in lanes_of(live & !lane_set) {
+            let VertexBsdf::Scalar(bsdf) = &bsdfs[i] else {
+                continue;
+            };
+            let mut source = PrefixedSource::new(&mut paths.streams[i], block.lane(i) + 3);
+            let Some(s) = bsdf.sample(wo.lane(i), &ctx, &mut source) else {
+                continue;
+            };
+            let put = |v: S, x: f64| S::from_fn(|j| if j == i { x } else { v.lane(j) });
+            wi = LVec3::new(put(wi.x, s.wi.x), put(wi.y, s.wi.y), put(wi.z, s.wi.z));
+            rgb_set(&mut weight, i, s.weight);
+            pdf = put(pdf, s.pdf);
+            eta = put(eta, s.eta);
+            if s.lobe.is_delta() {
+                delta |= 1 << i;
+            }
+            if s.lobe.intersects(LobeFlags::TRANSMISSION) {
+                transmitted |= 1 << i;
+            }
+            ok |= 1 << i;
+        }
+        // f32 lanes give directions of length 1 ± 1e-7: the f64 ray needs a unit one.
+        let wi_world = frame.to_world(vec_g(wi)).normalize();
+        let consistent = set_of((wi_world.dot(hl.ng) * to_g(wi.z)).gt(G::zero()));
+        let black =
+            set_of(weight[0].eq(S::zero()) & weight[1].eq(S::zero()) & weight[2].eq(S::zero()));
+        let go = live & ok & consistent & !black;
+        let ended = live & !go;
+        if ended != 0 {
+            Self::finish(paths, ended, sums);
+        }
+        if go == 0 {
+            return;
+        }
+        for c in 0..3 {
+            paths.beta[c] = merge(go, paths.beta[c] * weight[c], paths.beta[c]);
+        }
+        paths.delta_prev = (paths.delta_prev & !go) | (delta & go);
+        paths.prev_pdf = merge(go, pdf, paths.prev_pdf);
+        paths.prev_p = LVec3::select(M64x8::from_bits(go as u32), hl.p, paths.prev_p);
+        let refracted = go & transmitted;
+        paths.eta_scale = merge(refracted, paths.eta_scale * (eta * eta), paths.eta_scale);
+        paths.segment = U32x8::from_fn(|i| paths.segment.lane(i) + ((go >> i) & 1) as u32);
+        // Russian roulette after rr_depth segments.
+        let rr = go & set_of(paths.segment.gt_splat(self.scene.integrator.rr_depth));
+        let mut killed: Lanes = 0;
+        if rr != 0 {
+            let q = paths.beta[0].max(paths.beta[1]).max(paths.beta[2]) * paths.eta_scale;
+            let q = q.min(S::splat(0.95));
+            let u = self
+                .sampler
+                .get_lanes::<S>(
+                    &paths.samples,
+                    &mut paths.streams,
+                    block.wrapping_add(U32x8::splat(6)),
+                    rr,
+                    false,
+                )
+                .0;
+            let survive = set_of(q.gt(S::zero()) & u.lt(q));
+            killed = rr & !survive;
+            let kept = rr & survive;
+            for c in 0..3 {
+                paths.beta[c] = merge(kept, paths.beta[c] / q, paths.beta[c]);
+            }
+        }
+        let next = go & !killed;
+        let m = M64x8::from_bits(next as u32);
+        paths.o = LVec3::select(m, offset_origin_lanes(hl.p, hl.ng, wi_world), paths.o);
+        paths.d = LVec3::select(m, wi_world, paths.d);
+        if killed != 0 {
+            Self::finish(paths, killed, sums);
+        }
+    }
+}
+
+/// The constant environment's density of a direction: uniform over the sphere.
+#[inline(always)]
+fn constant_pdf(c: &ConstantEnvironment) -> f64 {
+    c.pdf(Vec3::Z)
+}
+
+/// [`power_heuristic`] over lanes.
+#[inline(always)]
+fn power_heuristic_lanes<S: Real>(a: S, b: S) -> S {
+    let (a2, b2) = (a * a, b * b);
+    let sum = a2 + b2;
+    S::select(sum.eq(S::zero()), S::zero(), a2 / sum)
+}
+
+/// Comparisons of u32 lanes with a constant.
+trait LaneCompare {
+    fn ge_splat(self, v: u32) -> M64x8;
+    fn gt_splat(self, v: u32) -> M64x8;
+}
+
+impl LaneCompare for U32x8 {
+    #[inline(always)]
+    fn ge_splat(self, v: u32) -> M64x8 {
+        M64x8::from_bits((0..LANES).fold(0, |s, i| s | ((self.lane(i) >= v) as u32) << i))
+    }
+    #[inline(always)]
+    fn gt_splat(self, v: u32) -> M64x8 {
+        M64x8::from_bits((0..LANES).fold(0, |s, i| s | ((self.lane(i) > v) as u32) << i))
+    }
 }
 
 #[cfg(test)]
@@ -573,6 +1025,10 @@ mod tests {
         center = [1, 0, 0]
         radius = 0.5
         material = "clay"
+        [[objects]]
+        shape = "rectangle"
+        transform = [{ scale = 0.5 }, { rotate = { axis = [1, 0, 0], angle = 90 } }, { translate = [0, 2, 0.5] }]
+        emission = 3.0
         [[lights]]
         type = "point"
         position = [1, 2, 2]
@@ -582,55 +1038,92 @@ mod tests {
         radiance = 0.5
     "#;
 
-    /// With f64 lanes the packet kernel is the scalar integrator in another order: every
-    /// pixel agrees to 1e-9 (the lane models differ from the f64 models only in how they
-    /// write the sampling weight and the dielectric's Fresnel term).
+    /// With f64 shading lanes the packet kernel is the scalar integrator in another order:
+    /// every pixel agrees to 1e-9 for every sampler and estimator (the lane models differ
+    /// from the f64 models only in how they write the sampling weight and the dielectric's
+    /// Fresnel term); f32 lanes render every sample too.
     #[test]
     fn f64_lanes_reproduce_the_scalar_integrator_sample_for_sample() {
         let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
         let (w, h) = (scene.film.width, scene.film.height);
-        let sampler = PixelSampler::new(SamplerKind::Sobol, 4, w, h, 8);
         let cameras = CameraSampling {
             footprints: false,
             diff_scale: 1.0,
         };
         let chunk: Vec<u32> = (0..8).collect();
-        let mut worst: f64 = 0.0;
-        for y in 0..h {
-            let mut lanes = vec![PixelSums::default(); w];
-            render_row_lanes::<f64>(
-                &scene,
-                &sampler,
-                cameras,
-                Strategy::Mis,
-                (0..w, y),
-                &chunk,
-                &mut lanes,
-            );
-            let mut f32_lanes = vec![PixelSums::default(); w];
-            render_row_lanes::<F32x8>(
-                &scene,
-                &sampler,
-                cameras,
-                Strategy::Mis,
-                (0..w, y),
-                &chunk,
-                &mut f32_lanes,
-            );
-            for x in 0..w {
-                let mut scalar = PixelSums::default();
-                for &s in &chunk {
-                    let mut stream = sampler.stream(x, y, s as u64);
-                    let (ray, rd) = cameras.ray(&scene, &mut stream, x, y);
-                    scalar.add(radiance(&scene, ray, rd, &mut stream, Strategy::Mis));
+        let never = || false;
+        for kind in [
+            SamplerKind::Sobol,
+            SamplerKind::Independent,
+            SamplerKind::Stratified,
+        ] {
+            for strategy in [Strategy::Mis, Strategy::NeeOnly, Strategy::BsdfOnly] {
+                let sampler = PixelSampler::new(kind, 4, w, h, 8);
+                let job = TileJob {
+                    scene: &scene,
+                    sampler: &sampler,
+                    cameras,
+                    strategy,
+                    xs: 0..w,
+                    ys: 0..h,
+                    chunk: &chunk,
+                    stop: &never,
+                };
+                let mut lanes = Vec::new();
+                assert_eq!(render_tile_lanes::<F64x8>(&job, &mut lanes), h);
+                let mut f32_lanes = Vec::new();
+                render_tile_lanes::<F32x8>(&job, &mut f32_lanes);
+                let mut worst: f64 = 0.0;
+                for y in 0..h {
+                    for x in 0..w {
+                        let mut scalar = PixelSums::default();
+                        for &s in &chunk {
+                            let mut stream = sampler.stream(x, y, s as u64);
+                            let (ray, rd) = cameras.ray(&scene, &mut stream, x, y);
+                            scalar.add(radiance(&scene, ray, rd, &mut stream, strategy));
+                        }
+                        let (a, b) = (scalar.sums(), lanes[y * w + x].sums());
+                        for c in 0..3 {
+                            worst = worst.max((a[c] - b[c]).abs() / a[c].abs().max(1e-3));
+                        }
+                        assert_eq!(lanes[y * w + x].count(), 8);
+                        assert_eq!(f32_lanes[y * w + x].count(), 8);
+                    }
                 }
-                let (a, b) = (scalar.sums(), lanes[x].sums());
-                for c in 0..3 {
-                    worst = worst.max((a[c] - b[c]).abs() / a[c].abs().max(1e-3));
-                }
-                assert_eq!(f32_lanes[x].count(), 8);
+                assert!(
+                    worst < 1e-9,
+                    "{kind:?} {strategy:?}: largest relative difference {worst:e}"
+                );
             }
         }
-        assert!(worst < 1e-9, "largest relative difference {worst:e}");
+    }
+
+    /// A stop before a row leaves that row and the later ones out.
+    #[test]
+    fn a_stop_ends_the_tile_at_a_row() {
+        let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
+        let sampler = PixelSampler::new(SamplerKind::Sobol, 1, 24, 16, 2);
+        let asked = std::cell::Cell::new(0);
+        let stop = || {
+            asked.set(asked.get() + 1);
+            asked.get() > 3
+        };
+        let job = TileJob {
+            scene: &scene,
+            sampler: &sampler,
+            cameras: CameraSampling {
+                footprints: false,
+                diff_scale: 1.0,
+            },
+            strategy: Strategy::Mis,
+            xs: 2..10,
+            ys: 0..16,
+            chunk: &[0, 1],
+            stop: &stop,
+        };
+        let mut sums = Vec::new();
+        assert_eq!(render_tile_lanes::<F32x8>(&job, &mut sums), 3);
+        assert_eq!(sums.len(), 3 * 8);
+        assert!(sums.iter().all(|p| p.count() == 2));
     }
 }

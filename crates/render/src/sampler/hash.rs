@@ -7,9 +7,15 @@
 //! - `hash_unit`: a 64-bit hash as a uniform number in [0, 1).
 //! - `owen_scramble`: the hash-based nested uniform (Owen) scramble of Burley 2020.
 //! - `permute`: a hash-keyed permutation of [0, n) (Kensler 2013).
+//! - `pcg4d`: a counter-based hash of four 32-bit words (the independent sampler's values).
+//!
+//! The hashes the render kernel evaluates eight samples at a time are written once over
+//! [`Bits32`] (`u32` for one sample, `U32x8` for eight).
 //!
 //! The 64-bit mixing itself is [`mix_seed`](facette_bsdf::math::rng::mix_seed) (the
 //! SplitMix64 finalizer), which the rest of the renderer already uses to derive seeds.
+
+use facette_bsdf::lanes::Bits32;
 
 /// The largest `f64` below 1 (1 − 2⁻⁵³): values computed as `(k + u) / n` may round up to
 /// 1.0 and are clamped to it.
@@ -42,12 +48,42 @@ pub(crate) fn owen_scramble(v: u32, seed: u32) -> u32 {
 /// reversals for its first dimension (the radical inverse is itself a reversal).
 #[inline]
 pub(crate) fn laine_karras(x: u32, seed: u32) -> u32 {
+    laine_karras_lanes(x, seed)
+}
+
+/// [`laine_karras`] over lanes.
+#[inline(always)]
+pub(crate) fn laine_karras_lanes<B: Bits32>(x: B, seed: B) -> B {
+    let mul = |v: B, c: u32| v.wrapping_mul(B::splat(c));
     let mut x = x.wrapping_add(seed);
-    x ^= x.wrapping_mul(0x6c50_b47c);
-    x ^= x.wrapping_mul(0xb82f_1e52);
-    x ^= x.wrapping_mul(0xc7af_e638);
-    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x = x ^ mul(x, 0x6c50_b47c);
+    x = x ^ mul(x, 0xb82f_1e52);
+    x = x ^ mul(x, 0xc7af_e638);
+    x = x ^ mul(x, 0x8d22_f6e6);
     x
+}
+
+/// A hash of four 32-bit words into four: Jarzynski & Olano 2020, "Hash Functions for GPU
+/// Rendering" (JCGT 9(3)), `pcg4d` — one LCG step per word, two rounds of cross-word
+/// multiply-adds around an xor-shift; among the fastest hashes of their survey with
+/// full-quality output, and it needs only 32-bit multiplies, which AVX2 does eight at a
+/// time. The samplers' chi-square tests check its marginals and neighbouring dimensions.
+#[inline(always)]
+pub(crate) fn pcg4d<B: Bits32>(v: [B; 4]) -> [B; 4] {
+    let mut v = v.map(|c| {
+        c.wrapping_mul(B::splat(1_664_525))
+            .wrapping_add(B::splat(1_013_904_223))
+    });
+    let round = |v: &mut [B; 4]| {
+        v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
+        v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
+        v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
+        v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
+    };
+    round(&mut v);
+    v = v.map(|c| c ^ c.shr(16));
+    round(&mut v);
+    v
 }
 
 /// Element `i` of a pseudo-random permutation of [0, n) chosen by `key`, in O(1) memory:

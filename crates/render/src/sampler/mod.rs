@@ -10,8 +10,8 @@
 //!   across pixels ([`sobol`]).
 //! - [`SamplerKind::Stratified`]: jittered strata per dimension, shuffled across
 //!   dimensions by a hash permutation (Kensler 2013) ([`stratified`]).
-//! - [`SamplerKind::Independent`]: the sample's PCG stream, exactly the numbers the
-//!   renderer drew before samplers existed.
+//! - [`SamplerKind::Independent`]: independent uniform numbers, each a counter-based hash
+//!   of (seed, pixel, sample number, dimension) (`hash::pcg4d`).
 //!
 //! Every value is a pure function of the seed, the construction arguments, the pixel, the
 //! sample number and the dimension — nothing depends on which samples were drawn before or
@@ -23,17 +23,21 @@
 //! Numbers without a dimension (a stochastic BSDF's evaluation, draws beyond a vertex's
 //! block) come from [`SampleStream::rng`], the sample's own PCG stream, and a BSDF's sample
 //! routine gets its dimensions and then that stream through a [`PrefixedSource`].
+//!
+//! The render kernel draws the numbers of eight camera samples at once ([`lanes`]): the
+//! same values, from the same hashes written once over 32-bit lanes.
 
 pub mod hash;
+pub(crate) mod lanes;
 pub mod prefixed_source;
 pub mod sobol;
 pub mod stratified;
 
 pub use prefixed_source::PrefixedSource;
 
-use facette_bsdf::math::rng::{mix_seed, Pcg32, RandomSource};
+use facette_bsdf::math::rng::{mix_seed, Pcg32};
 use glam::DVec2;
-use sobol::{ZSobol, ZSobolSample};
+use sobol::{DimSeeds, ZSobol, ZSobolSample};
 use stratified::{Strata, StrataSample};
 
 /// Which sampler a render uses.
@@ -42,7 +46,7 @@ pub enum SamplerKind {
     /// Owen-scrambled Sobol in Morton order (pbrt-v4's ZSobol).
     #[default]
     Sobol,
-    /// Independent uniform numbers from the sample's PCG stream.
+    /// Independent uniform numbers, a hash of (seed, pixel, sample, dimension) each.
     Independent,
     /// Jittered strata per dimension.
     Stratified,
@@ -90,6 +94,23 @@ pub struct PixelSampler {
     /// For the PCG stream's pixel number, y · width + x.
     width: u64,
     layout: Layout,
+    /// Sobol with an index of at most 32 bits: each dimension's seeds under the render's
+    /// common key, for the first [`lanes::TABULATED_DIMENSIONS`] dimensions (the render
+    /// kernel's lanes read them; empty otherwise).
+    dim_seeds: Vec<DimSeeds>,
+}
+
+/// Domain separation of the independent sampler's per-sample key (an arbitrary odd
+/// constant), and the fourth word of its hash.
+const INDEPENDENT_TAG: u64 = 0x1dec_0de5_0000_0007;
+const INDEPENDENT_WORD: u32 = 0x6a09_e667;
+
+/// The independent sampler's point of dimension `dim` (the first coordinate its 1D
+/// value): the hash of the sample's key and the dimension, over lanes.
+#[inline(always)]
+pub(crate) fn independent_point<B: facette_bsdf::lanes::Bits32>(key: [B; 2], dim: B) -> (B, B) {
+    let v = hash::pcg4d([key[0], key[1], dim, B::splat(INDEPENDENT_WORD)]);
+    (v[0], v[1])
 }
 
 impl PixelSampler {
@@ -108,11 +129,18 @@ impl PixelSampler {
             SamplerKind::Independent => Layout::Independent,
             SamplerKind::Stratified => Layout::Stratified(Strata::new(seed, spp)),
         };
+        let dim_seeds = match &layout {
+            Layout::Sobol(z) if z.index_bits() <= 32 => (0..lanes::TABULATED_DIMENSIONS)
+                .map(|d| DimSeeds::new(z.common_key(), d))
+                .collect(),
+            _ => Vec::new(),
+        };
         PixelSampler {
             kind,
             seed,
             width: width as u64,
             layout,
+            dim_seeds,
         }
     }
 
@@ -128,7 +156,9 @@ impl PixelSampler {
         let rng = Pcg32::new(mix_seed(self.seed, pixel), sample_index);
         let pattern = match &self.layout {
             Layout::Sobol(z) => Pattern::Sobol(z.start(x, y, sample_index)),
-            Layout::Independent => Pattern::Independent,
+            Layout::Independent => Pattern::Independent {
+                key: mix_seed(mix_seed(self.seed ^ INDEPENDENT_TAG, pixel), sample_index),
+            },
             Layout::Stratified(s) => Pattern::Stratified(s.start(x, y, sample_index)),
         };
         SampleStream {
@@ -143,7 +173,7 @@ impl PixelSampler {
 #[derive(Clone, Debug)]
 enum Pattern {
     Sobol(ZSobolSample),
-    Independent,
+    Independent { key: u64 },
     Stratified(StrataSample),
 }
 
@@ -151,9 +181,21 @@ enum Pattern {
 #[derive(Clone, Debug)]
 pub struct SampleStream {
     rng: Pcg32,
-    /// The next dimension (unused by `Independent`).
+    /// The next dimension.
     dimension: u32,
     pattern: Pattern,
+}
+
+/// A 64-bit key as the two 32-bit words of the hashes.
+#[inline(always)]
+fn split(key: u64) -> [u32; 2] {
+    [key as u32, (key >> 32) as u32]
+}
+
+/// A 32-bit fraction as an `f64` in [0, 1) (exact).
+#[inline(always)]
+fn to_unit(bits: u32) -> f64 {
+    bits as f64 * (1.0 / (1u64 << 32) as f64)
 }
 
 impl SampleStream {
@@ -162,7 +204,10 @@ impl SampleStream {
         let d = self.dimension;
         let v = match &self.pattern {
             Pattern::Sobol(z) => z.get_1d(d),
-            Pattern::Independent => return self.rng.next_f64(),
+            Pattern::Independent { key } => {
+                let (x, _) = independent_point(split(*key), d);
+                to_unit(x)
+            }
             Pattern::Stratified(s) => s.get_1d(d),
         };
         self.dimension = d.wrapping_add(1);
@@ -175,7 +220,10 @@ impl SampleStream {
         let d = self.dimension;
         let v = match &self.pattern {
             Pattern::Sobol(z) => z.get_2d(d),
-            Pattern::Independent => return self.rng.next_2d(),
+            Pattern::Independent { key } => {
+                let (x, y) = independent_point(split(*key), d);
+                DVec2::new(to_unit(x), to_unit(y))
+            }
             Pattern::Stratified(s) => s.get_2d(d),
         };
         self.dimension = d.wrapping_add(2);
@@ -183,14 +231,13 @@ impl SampleStream {
     }
 
     /// Next dimension where the caller reads it (`used`), else the dimension is skipped and
-    /// ½ returned. A dimensioned sampler (Sobol, stratified) then does no work for a
-    /// number nobody reads — a pinhole camera's lens, the light choice among one light, a
-    /// point light's position, a one-lobe material's lobe — and every other dimension keeps
-    /// its value, so images do not change. `Independent` still draws (its PCG stream is
-    /// consumed in call order, and its images stay those of before).
+    /// ½ returned: the sampler then does no work for a number nobody reads — a pinhole
+    /// camera's lens, the light choice among one light, a point light's position, a
+    /// one-lobe material's lobe — and every other dimension keeps its value (a value is a
+    /// function of its dimension), so images do not change.
     #[inline]
     pub fn get_1d_where(&mut self, used: bool) -> f64 {
-        if used || matches!(self.pattern, Pattern::Independent) {
+        if used {
             self.get_1d()
         } else {
             self.dimension = self.dimension.wrapping_add(1);
@@ -202,7 +249,7 @@ impl SampleStream {
     /// (see [`get_1d_where`](Self::get_1d_where)).
     #[inline]
     pub fn get_2d_where(&mut self, used: bool) -> DVec2 {
-        if used || matches!(self.pattern, Pattern::Independent) {
+        if used {
             self.get_2d()
         } else {
             self.dimension = self.dimension.wrapping_add(2);
@@ -210,16 +257,8 @@ impl SampleStream {
         }
     }
 
-    /// Whether every value is a function of its dimension (Sobol, stratified), so that
-    /// numbers may be drawn in any order or not at all; `false` for `Independent`, whose
-    /// values depend on how many were drawn before.
-    #[inline]
-    pub fn is_dimensioned(&self) -> bool {
-        !matches!(self.pattern, Pattern::Independent)
-    }
-
     /// Jump to dimension `d` (the integrator gives each path vertex a fixed block of
-    /// dimensions). No-op for `Independent`.
+    /// dimensions).
     pub fn set_dimension(&mut self, d: u32) {
         self.dimension = d;
     }
@@ -290,7 +329,7 @@ mod tests {
                 }
             }
             // set_dimension(d) then get_1d / get_2d equals drawing d values first.
-            if kind != SamplerKind::Independent {
+            {
                 let all = draw(&mut s.stream(9, 1, 17), 30, false);
                 for (d, &value) in all.iter().enumerate() {
                     let mut st = s.stream(9, 1, 17);
@@ -316,25 +355,14 @@ mod tests {
             for (x, y, i) in [(0usize, 0usize, 0u64), (319, 199, 63), (17, 5, 1000)] {
                 let mut reference = Pcg32::new(mix_seed(seed, (y * w + x) as u64), i);
                 let mut st = s.stream(x, y, i);
-                // Dimensioned draws of Sobol / Stratified do not touch the PCG stream.
-                if kind != SamplerKind::Independent {
-                    let _ = st.get_2d();
-                    let _ = st.get_1d();
-                }
+                // Dimensioned draws do not touch the PCG stream.
+                let _ = st.get_2d();
+                let _ = st.get_1d();
                 for _ in 0..8 {
                     assert_eq!(st.rng().next_u32(), reference.next_u32());
                 }
             }
         }
-        // Independent: get_1d / get_2d are today's draws, in today's order.
-        let s = PixelSampler::new(SamplerKind::Independent, seed, w, 200, 64);
-        let mut st = s.stream(3, 4, 5);
-        let mut reference = Pcg32::new(mix_seed(seed, (4 * w + 3) as u64), 5);
-        st.set_dimension(17);
-        assert_eq!(st.get_2d(), reference.next_2d());
-        assert_eq!(st.get_1d(), reference.next_f64());
-        assert_eq!(st.get_2d(), reference.next_2d());
-        assert_eq!(st.rng().next_f64(), reference.next_f64());
     }
 
     #[test]

@@ -10,27 +10,24 @@
 //!
 //! The two prefix values are drawn when the model first asks for them: a model that never
 //! draws a lobe number (one lobe) costs the sampler nothing for it. Their values do not
-//! depend on when they are drawn (a dimension's value is a function of the dimension),
-//! except with the `Independent` sampler, for which both are drawn at construction in the
-//! order they always were.
+//! depend on when they are drawn (a dimension's value is a function of the dimension).
 
 use super::SampleStream;
 use facette_bsdf::math::rng::RandomSource;
 use glam::DVec2;
 
-/// One prefix value: its dimension until drawn, then its value, then taken.
+/// One prefix value: its dimension until drawn, then taken.
 #[derive(Clone, Copy, Debug)]
-enum Prefix<T> {
+enum Prefix {
     Dimension(u32),
-    Drawn(T),
     Taken,
 }
 
 /// Its first `next_f64` call returns the lobe dimension's value, its first `next_2d` call
 /// the direction pair's; every other call draws from the sample's free PCG stream.
 pub struct PrefixedSource<'a> {
-    lobe: Prefix<f64>,
-    direction: Prefix<DVec2>,
+    lobe: Prefix,
+    direction: Prefix,
     stream: &'a mut SampleStream,
 }
 
@@ -38,18 +35,9 @@ impl<'a> PrefixedSource<'a> {
     /// The lobe number at dimension `lobe_dimension` of `stream`, the direction pair at the
     /// two dimensions after it.
     pub fn new(stream: &'a mut SampleStream, lobe_dimension: u32) -> Self {
-        let (mut lobe, mut direction) = (
-            Prefix::Dimension(lobe_dimension),
-            Prefix::Dimension(lobe_dimension + 1),
-        );
-        if !stream.is_dimensioned() {
-            stream.set_dimension(lobe_dimension);
-            lobe = Prefix::Drawn(stream.get_1d());
-            direction = Prefix::Drawn(stream.get_2d());
-        }
         PrefixedSource {
-            lobe,
-            direction,
+            lobe: Prefix::Dimension(lobe_dimension),
+            direction: Prefix::Dimension(lobe_dimension + 1),
             stream,
         }
     }
@@ -63,7 +51,6 @@ impl RandomSource for PrefixedSource<'_> {
                 self.stream.set_dimension(d);
                 self.stream.get_1d()
             }
-            Prefix::Drawn(v) => v,
             Prefix::Taken => self.stream.rng().next_f64(),
         }
     }
@@ -75,7 +62,6 @@ impl RandomSource for PrefixedSource<'_> {
                 self.stream.set_dimension(d);
                 self.stream.get_2d()
             }
-            Prefix::Drawn(v) => v,
             Prefix::Taken => self.stream.rng().next_2d(),
         }
     }
@@ -94,7 +80,11 @@ mod tests {
     /// whichever is asked first, drawn or not; further draws come from the PCG stream.
     #[test]
     fn sampler_prefixed_source_takes_the_vertex_dimensions_in_either_order() {
-        for kind in [SamplerKind::Sobol, SamplerKind::Stratified] {
+        for kind in [
+            SamplerKind::Sobol,
+            SamplerKind::Stratified,
+            SamplerKind::Independent,
+        ] {
             let mut expected = stream(kind);
             expected.set_dimension(9);
             let (lobe, dir) = (expected.get_1d(), expected.get_2d());
@@ -118,21 +108,5 @@ mod tests {
             assert_eq!(src.next_2d(), dir);
             assert_eq!(src.next_f64(), reference.next_f64());
         }
-    }
-
-    /// The independent sampler draws the lobe number, then the pair, from its PCG stream at
-    /// construction, whatever the model asks first: its images stay those of before.
-    #[test]
-    fn sampler_prefixed_source_independent_draws_in_the_old_order() {
-        let mut expected = stream(SamplerKind::Independent);
-        let (lobe, dir) = (expected.get_1d(), expected.get_2d());
-        let mut reference = expected.rng().clone();
-        let mut s = stream(SamplerKind::Independent);
-        let mut src = PrefixedSource::new(&mut s, 9);
-        assert_eq!(src.next_2d(), dir);
-        assert_eq!(src.next_f64(), lobe);
-        assert_eq!(src.next_f64(), reference.next_f64());
-        // The generator has advanced by exactly the draws made.
-        assert_eq!(s.rng().next_u32(), reference.next_u32());
     }
 }

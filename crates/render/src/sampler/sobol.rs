@@ -32,7 +32,8 @@
 //! sample numbers at or above the rounded-up spp (which have no place in the pixel's
 //! block) an independent tile; nothing overflows and every sample keeps its own numbers.
 
-use super::hash::{laine_karras, owen_scramble};
+use super::hash::{laine_karras, laine_karras_lanes, owen_scramble};
+use facette_bsdf::lanes::Bits32;
 use facette_bsdf::math::rng::mix_seed;
 use glam::DVec2;
 
@@ -86,6 +87,7 @@ fn scrambled_sobol_0(index: u32, seed: u32) -> u32 {
 /// The generator matrix of dimension 1 applied to every byte value at each of the four
 /// byte positions of an index: `SOBOL_1_BYTES[k][b]` is the xor of the columns of the set
 /// bits of `b << 8k`, so a product costs four lookups instead of one xor per set bit.
+#[cfg(test)]
 const SOBOL_1_BYTES: [[u32; 256]; 4] = sobol_1_byte_tables();
 
 const fn sobol_1_byte_tables() -> [[u32; 256]; 4] {
@@ -110,8 +112,38 @@ const fn sobol_1_byte_tables() -> [[u32; 256]; 4] {
     t
 }
 
+/// [`SOBOL_1_BYTES`] with every entry's bits reversed: the reversal of a product is the xor
+/// of the reversed columns, so `owen_scramble(sobol_1(i), s)`, which reverses the product
+/// first, takes these instead.
+const SOBOL_1_REVERSED_BYTES: [[u32; 256]; 4] = {
+    let mut t = sobol_1_byte_tables();
+    let mut k = 0;
+    while k < 4 {
+        let mut b = 0;
+        while b < 256 {
+            t[k][b] = t[k][b].reverse_bits();
+            b += 1;
+        }
+        k += 1;
+    }
+    t
+};
+
+/// `sobol_1(index).reverse_bits()`, lane by lane (four table lookups each).
+#[inline(always)]
+fn sobol_1_reversed<B: Bits32>(index: B) -> B {
+    B::from_fn(|i| {
+        let b = index.lane(i).to_le_bytes();
+        SOBOL_1_REVERSED_BYTES[0][b[0] as usize]
+            ^ SOBOL_1_REVERSED_BYTES[1][b[1] as usize]
+            ^ SOBOL_1_REVERSED_BYTES[2][b[2] as usize]
+            ^ SOBOL_1_REVERSED_BYTES[3][b[3] as usize]
+    })
+}
+
 /// Sobol dimension 1 of `index` as a 32-bit fraction: the xor of the generator columns of
 /// the index's set bits, a byte at a time.
+#[cfg(test)]
 #[inline]
 fn sobol_1(index: u32) -> u32 {
     let b = index.to_le_bytes();
@@ -151,6 +183,61 @@ fn nested_scramble(index: u64, bits: u32, key: u64) -> u64 {
     ((high_scrambled as u64) << 32) | low_scrambled as u64
 }
 
+/// The hashes of one dimension of a sample whose index has at most 32 bits (every image of
+/// up to 65536² pixels at up to 2^32 / pixels samples): the nested scramble's key and the
+/// Owen seeds of the point's two coordinates — what [`ZSobolSample::dimension`] derives
+/// from the sample's key, in the form the render kernel tabulates per dimension (the key is
+/// one constant per render there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct DimSeeds {
+    pub(crate) field: u32,
+    pub(crate) s0: u32,
+    pub(crate) s1: u32,
+}
+
+impl DimSeeds {
+    #[inline]
+    pub(crate) fn new(key: u64, dim: u32) -> DimSeeds {
+        let dim_key = mix_seed(key, dim as u64);
+        // The index bits above 32 are zero.
+        let h = mix_seed(dim_key ^ OWEN_TAG, 0);
+        DimSeeds {
+            field: dim_key as u32,
+            s0: h as u32,
+            s1: (h >> 32) as u32,
+        }
+    }
+}
+
+/// The scrambled point of one dimension of a sample whose index has `bits` ≤ 32 bits,
+/// from `reversed` = the index's bits reversed at the top of the word
+/// (`(index << (32 − bits)).reverse_bits()`, a per-sample constant): the nested scramble of
+/// the index ([`nested_scramble`]), then Sobol dimension 0 scrambled and, if `pair`,
+/// dimension 1 scrambled — [`ZSobolSample::get_1d`] / [`get_2d`](ZSobolSample::get_2d)
+/// written once over lanes, for one sample and for eight.
+#[inline(always)]
+pub(crate) fn short_index_point<B: Bits32>(
+    reversed: B,
+    bits: u32,
+    seeds: [B; 3],
+    pair: bool,
+) -> (B, B) {
+    let index = if bits == 0 {
+        B::splat(0)
+    } else {
+        laine_karras_lanes(reversed, seeds[0])
+            .reverse()
+            .shr(32 - bits)
+    };
+    let x = laine_karras_lanes(index, seeds[1]).reverse();
+    let y = if pair {
+        laine_karras_lanes(sobol_1_reversed(index), seeds[2]).reverse()
+    } else {
+        B::splat(0)
+    };
+    (x, y)
+}
+
 /// Interleaves the bits of x (even positions) and y (odd positions): the Morton code.
 #[inline]
 pub(crate) fn morton2(x: u32, y: u32) -> u64 {
@@ -182,6 +269,8 @@ pub(crate) struct ZSobol {
     /// Pixel quadtree levels in the index: ⌈log2 max(width, height)⌉, reduced so that
     /// 2 · levels + log2_spp ≤ 64. Coarser levels go to the tile hash.
     levels: u32,
+    /// The key of the samples of tile (0, 0) within the spp ([`ZSobol::common_key`]).
+    common_key: u64,
 }
 
 impl ZSobol {
@@ -195,12 +284,13 @@ impl ZSobol {
             seed,
             log2_spp,
             levels,
+            common_key: mix_seed(mix_seed(mix_seed(seed ^ ZSOBOL_TAG, 0), 0), 0),
         }
     }
 
     /// Bits of the (per-dimension permuted) index in use.
     #[inline]
-    fn index_bits(&self) -> u32 {
+    pub(crate) fn index_bits(&self) -> u32 {
         2 * self.levels + self.log2_spp
     }
 
@@ -226,11 +316,24 @@ impl ZSobol {
             mix_seed(mix_seed(self.seed ^ ZSOBOL_TAG, tile_x), tile_y),
             extra,
         );
+        let bits = self.index_bits();
         ZSobolSample {
             layout: *self,
             index,
             key,
+            reversed: if bits == 0 || bits > 32 {
+                0
+            } else {
+                ((index as u32) << (32 - bits)).reverse_bits()
+            },
         }
+    }
+
+    /// The key of every sample when the index has at most 32 bits (one tile) and the sample
+    /// number is within the render's spp: what the render kernel's per-dimension table of
+    /// [`DimSeeds`] is built from.
+    pub(crate) fn common_key(&self) -> u64 {
+        self.common_key
     }
 }
 
@@ -242,6 +345,9 @@ pub(crate) struct ZSobolSample {
     index: u64,
     /// Hash of the seed and of what did not fit in `index`.
     key: u64,
+    /// For an index of at most 32 bits, its bits reversed at the top of the word (the
+    /// argument of [`short_index_point`]).
+    reversed: u32,
 }
 
 impl ZSobolSample {
@@ -264,20 +370,43 @@ impl ZSobolSample {
         (index as u32, [h as u32, (h >> 32) as u32])
     }
 
+    /// The lane form of this sample, where it has one: its reversed index (an index of at
+    /// most 32 bits under the render's common key, [`ZSobol::common_key`]).
+    #[inline]
+    pub(crate) fn lane_word(&self) -> Option<u32> {
+        let bits = self.layout.index_bits();
+        (bits <= 32 && self.key == self.layout.common_key).then_some(self.reversed)
+    }
+
+    /// The point of dimension `dim` (and `dim + 1` if `pair`) as 32-bit fractions.
+    #[inline]
+    fn point(&self, dim: u32, pair: bool) -> (u32, u32) {
+        let bits = self.layout.index_bits();
+        if bits <= 32 {
+            let s = DimSeeds::new(self.key, dim);
+            return short_index_point(self.reversed, bits, [s.field, s.s0, s.s1], pair);
+        }
+        let (index, seeds) = self.dimension(dim);
+        (
+            scrambled_sobol_0(index, seeds[0]),
+            if pair {
+                owen_scramble(sobol_1_reversed(index).reverse_bits(), seeds[1])
+            } else {
+                0
+            },
+        )
+    }
+
     /// Camera-sample dimension `dim` as one number: Sobol dimension 0, scrambled.
     pub(crate) fn get_1d(&self, dim: u32) -> f64 {
-        let (index, seeds) = self.dimension(dim);
-        to_unit(scrambled_sobol_0(index, seeds[0]))
+        to_unit(self.point(dim, false).0)
     }
 
     /// Camera-sample dimensions `dim` and `dim + 1` as one pair: Sobol dimensions 0 and 1 of
     /// one index, each with its own scramble. Its first coordinate equals `get_1d(dim)`.
     pub(crate) fn get_2d(&self, dim: u32) -> DVec2 {
-        let (index, seeds) = self.dimension(dim);
-        DVec2::new(
-            to_unit(scrambled_sobol_0(index, seeds[0])),
-            to_unit(owen_scramble(sobol_1(index), seeds[1])),
-        )
+        let (x, y) = self.point(dim, true);
+        DVec2::new(to_unit(x), to_unit(y))
     }
 }
 
@@ -332,6 +461,33 @@ mod tests {
             let (i, seed) = (h as u32, (h >> 32) as u32);
             assert_eq!(scrambled_sobol_0(i, seed), owen_scramble(sobol_0(i), seed));
         }
+    }
+
+    /// The lane form of a short index (at most 32 bits) gives the general path's points, to
+    /// the bit: the fast path changes no image.
+    #[test]
+    fn sampler_short_index_points_are_the_general_points() {
+        for (w, h, spp) in [(8, 8, 16), (512, 384, 256), (1, 1, 1), (65536, 65536, 1)] {
+            let z = ZSobol::new(5, w, h, spp);
+            assert!(z.index_bits() <= 32);
+            let mut r = 0x9e37_79b9_7f4a_7c15u64;
+            for _ in 0..4000 {
+                r = mix_seed(r, 3);
+                let (x, y) = ((r % w as u64) as usize, ((r >> 20) % h as u64) as usize);
+                let s = (r >> 40) % spp as u64;
+                let dim = (r >> 58) as u32 * 5 + (r & 7) as u32;
+                let zs = z.start(x, y, s);
+                let (index, seeds) = zs.dimension(dim);
+                let general = (
+                    scrambled_sobol_0(index, seeds[0]),
+                    owen_scramble(sobol_1(index), seeds[1]),
+                );
+                assert_eq!(zs.point(dim, true), general, "{w}x{h} {spp} spp");
+                assert_eq!(zs.lane_word(), Some(zs.reversed));
+            }
+        }
+        // A sample beyond the spp has its own key: no lane form.
+        assert_eq!(ZSobol::new(1, 4, 4, 4).start(0, 0, 4).lane_word(), None);
     }
 
     #[test]

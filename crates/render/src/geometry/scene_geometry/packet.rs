@@ -1,19 +1,19 @@
 //! Ray queries for a packet of eight rays ([`Bvh::closest_hit_packet`],
-//! [`Bvh::any_hit_packet`]): spheres are tested four lanes at a time by their one-source
-//! test ([`Sphere::intersect_lanes`] with `F64x4`: the same bits as one ray at a time),
+//! [`Bvh::any_hit_packet`]): spheres are tested eight lanes at a time by their one-source
+//! test ([`Sphere::intersect_lanes`] with `F64x8`: the same bits as one ray at a time),
 //! triangles, rectangles and disks lane by lane with their one-ray tests. A lane's hit is
 //! therefore the hit the one-ray query finds; only among primitives hit at exactly the
 //! same distance may the two orders pick different ones.
 
-use super::{is_valid_query, HitDetail, SceneGeometry};
+use super::{HitDetail, SceneGeometry};
 use crate::geometry::bvh::{lanes_of, Lanes, PacketBox, PACKET};
 use crate::geometry::interaction::{PrimHit, SurfaceHit};
 use crate::geometry::ray::Ray;
 use crate::geometry::shape::Shape;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::TriangleRay;
-use crate::geometry::Vec2;
-use facette_bsdf::lanes::{F64x4, LVec3};
+use crate::geometry::{Vec2, Vec3};
+use facette_bsdf::lanes::{F64x8, LVec3, M64x8, Real};
 
 /// A packet lane's closest hit: the primitive's slot in the BVH order and the hit.
 #[derive(Clone, Copy, Debug)]
@@ -22,44 +22,84 @@ pub struct PacketHit {
     hit: PrimHit,
 }
 
-/// The packet's rays in lanes: f64 coordinates per axis (lanes without a valid ray hold
-/// a harmless one), and as two groups of four f64 lanes for the sphere test.
-struct LaneRays {
-    o: [[f64; PACKET]; 3],
-    d: [[f64; PACKET]; 3],
-    t_max: [f64; PACKET],
-    /// The lanes with a valid ray.
-    lanes: Lanes,
+impl PacketHit {
+    /// The ray distance of the hit.
+    #[inline]
+    pub fn t(&self) -> f64 {
+        self.hit.t
+    }
+}
+
+/// Eight rays in lanes (structure of arrays): f64 origins and directions per axis, their
+/// limits, and the lanes that hold a ray. The render kernel keeps its paths' rays in this
+/// form; lanes without a valid ray hold a harmless one.
+#[derive(Clone, Copy, Debug)]
+pub struct LaneRays {
+    pub o: LVec3<F64x8>,
+    pub d: LVec3<F64x8>,
+    pub t_max: F64x8,
+    /// The lanes with a valid ray (finite origin, finite non-zero direction).
+    pub lanes: Lanes,
 }
 
 impl LaneRays {
+    /// The rays of `lanes` from `o` along `d` up to `t_max`; a lane whose ray is not a
+    /// valid query (a non-finite origin, a zero or non-finite direction) is dropped and
+    /// given a harmless ray.
     #[inline(always)]
-    fn new(rays: &[Option<Ray>; PACKET]) -> LaneRays {
-        let mut r = LaneRays {
-            o: [[0.0; PACKET]; 3],
-            d: [[1.0; PACKET]; 3],
-            t_max: [0.0; PACKET],
-            lanes: 0,
-        };
-        for (i, ray) in rays.iter().enumerate() {
-            let Some(ray) = ray.filter(is_valid_query) else {
-                continue;
-            };
-            for a in 0..3 {
-                r.o[a][i] = ray.origin[a];
-                r.d[a][i] = ray.dir[a];
-            }
-            r.t_max[i] = ray.t_max;
-            r.lanes |= 1 << i;
+    pub fn new(o: LVec3<F64x8>, d: LVec3<F64x8>, t_max: F64x8, lanes: Lanes) -> LaneRays {
+        let valid = o.x.is_finite()
+            & o.y.is_finite()
+            & o.z.is_finite()
+            & d.x.is_finite()
+            & d.y.is_finite()
+            & d.z.is_finite()
+            & !(d.x.eq(F64x8::zero()) & d.y.eq(F64x8::zero()) & d.z.eq(F64x8::zero()));
+        let lanes = lanes & valid.bits() as Lanes;
+        let m = M64x8::from_bits(lanes as u32);
+        let unit = LVec3::new(F64x8::zero(), F64x8::zero(), F64x8::one());
+        LaneRays {
+            o: LVec3::select(m, o, LVec3::zero()),
+            d: LVec3::select(m, d, unit),
+            t_max: F64x8::select(m, t_max, F64x8::zero()),
+            lanes,
         }
-        r
     }
 
-    /// Group `h` (lanes 4h..4h + 4) of the coordinates `c`.
+    /// The packet of `rays` (`None` lanes hold no ray).
     #[inline(always)]
-    fn group(c: &[[f64; PACKET]; 3], h: usize) -> LVec3<F64x4> {
-        let g = |a: usize| F64x4(std::array::from_fn(|j| c[a][4 * h + j]));
-        LVec3::new(g(0), g(1), g(2))
+    pub fn from_rays(rays: &[Option<Ray>; PACKET]) -> LaneRays {
+        let lanes = (0..PACKET).fold(0, |set, i| set | ((rays[i].is_some() as Lanes) << i));
+        let ray = |i: usize| {
+            rays[i].unwrap_or(Ray {
+                origin: Vec3::ZERO,
+                dir: Vec3::Z,
+                t_max: 0.0,
+            })
+        };
+        let v = |f: &dyn Fn(&Ray) -> Vec3| LVec3::from_fn(|i| f(&ray(i)));
+        LaneRays::new(
+            v(&|r| r.origin),
+            v(&|r| r.dir),
+            F64x8::from_fn(|i| ray(i).t_max),
+            lanes,
+        )
+    }
+
+    /// Lane `i`'s ray.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        Ray {
+            origin: self.o.lane(i),
+            dir: self.d.lane(i),
+            t_max: self.t_max.0[i],
+        }
+    }
+
+    /// The coordinates as arrays per axis (the traversal's set-up reads them so).
+    #[inline(always)]
+    fn axes(v: &LVec3<F64x8>) -> [[f64; PACKET]; 3] {
+        [v.x.0, v.y.0, v.z.0]
     }
 
     /// The lanes of `lanes` whose ray hits `sphere` in `(0, t_max[i]]`, with the distance.
@@ -70,19 +110,66 @@ impl LaneRays {
         lanes: Lanes,
         t_max: &[f64; PACKET],
     ) -> (Lanes, [f64; PACKET]) {
-        let mut hit = 0;
-        let mut t = [0.0; PACKET];
-        for h in 0..2 {
-            if (lanes >> (4 * h)) & 0xF == 0 {
-                continue;
-            }
-            let limit = F64x4(std::array::from_fn(|j| t_max[4 * h + j]));
-            let (o, d) = (Self::group(&self.o, h), Self::group(&self.d, h));
-            let (m, th) = sphere.intersect_lanes(o, d, limit);
-            hit |= (m.bits() as Lanes) << (4 * h);
-            t[4 * h..4 * h + 4].copy_from_slice(&th.0);
+        let (m, t) = sphere.intersect_lanes(self.o, self.d, F64x8(*t_max));
+        (m.bits() as Lanes & lanes, t.0)
+    }
+}
+
+/// The surface records of a packet's hits in lanes (structure of arrays): what
+/// [`packet_hit_record`](SceneGeometry::packet_hit_record) gives each lane with
+/// [`HitDetail::Shading`], sphere hits computed eight lanes at a time by their one-source
+/// record ([`Sphere::shading_hit_lanes`]; their `dpdv` and `uv` are left at zero until
+/// [`complete_hit`](SceneGeometry::complete_hit)), the other shapes lane by lane.
+#[derive(Clone, Copy, Debug)]
+pub struct HitLanes {
+    pub t: F64x8,
+    pub p: LVec3<F64x8>,
+    pub ng: LVec3<F64x8>,
+    pub ns: LVec3<F64x8>,
+    pub dpdu: LVec3<F64x8>,
+    pub dpdv: LVec3<F64x8>,
+    pub uv: [[f64; PACKET]; 2],
+    pub shape: [u32; PACKET],
+    pub prim: [u32; PACKET],
+    /// The lanes with a hit.
+    pub lanes: Lanes,
+}
+
+impl HitLanes {
+    /// Lane `i`'s record.
+    #[inline]
+    pub fn surface_hit(&self, i: usize) -> SurfaceHit {
+        SurfaceHit {
+            t: self.t.0[i],
+            p: self.p.lane(i),
+            ng: self.ng.lane(i),
+            ns: self.ns.lane(i),
+            uv: Vec2::new(self.uv[0][i], self.uv[1][i]),
+            dpdu: self.dpdu.lane(i),
+            dpdv: self.dpdv.lane(i),
+            shape: self.shape[i],
+            prim: self.prim[i],
         }
-        (hit & lanes, t)
+    }
+
+    /// Stores `h` in lane `i`.
+    #[inline]
+    fn set(&mut self, i: usize, h: &SurfaceHit) {
+        let put = |v: &mut LVec3<F64x8>, w: Vec3| {
+            v.x.0[i] = w.x;
+            v.y.0[i] = w.y;
+            v.z.0[i] = w.z;
+        };
+        self.t.0[i] = h.t;
+        put(&mut self.p, h.p);
+        put(&mut self.ng, h.ng);
+        put(&mut self.ns, h.ns);
+        put(&mut self.dpdu, h.dpdu);
+        put(&mut self.dpdv, h.dpdv);
+        self.uv[0][i] = h.uv.x;
+        self.uv[1][i] = h.uv.y;
+        self.shape[i] = h.shape;
+        self.prim[i] = h.prim;
     }
 }
 
@@ -90,8 +177,7 @@ impl LaneRays {
 /// method forced inline so that it is compiled into the kernel's AVX2 instantiation.
 struct Closest<'a> {
     geometry: &'a SceneGeometry,
-    rays: &'a [Option<Ray>; PACKET],
-    lane_rays: &'a LaneRays,
+    rays: &'a LaneRays,
     best: [Option<PacketHit>; PACKET],
     tri: [Option<TriangleRay>; PACKET],
 }
@@ -103,7 +189,7 @@ impl Closest<'_> {
     fn test(&mut self, slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]) -> Lanes {
         let g = self.geometry;
         if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
-            let (hit, t) = self.lane_rays.sphere(s, lanes, t_max);
+            let (hit, t) = self.rays.sphere(s, lanes, t_max);
             for i in lanes_of(hit) {
                 t_max[i] = t[i];
                 self.best[i] = Some(PacketHit {
@@ -118,8 +204,8 @@ impl Closest<'_> {
         }
         let mut found = 0;
         for i in lanes_of(lanes) {
-            let Some(ray) = &self.rays[i] else { continue };
-            if let Some(h) = g.test_prim(slot, ray, &mut self.tri[i], t_max[i]) {
+            let ray = self.rays.ray(i);
+            if let Some(h) = g.test_prim(slot, &ray, &mut self.tri[i], t_max[i]) {
                 if h.t <= t_max[i] {
                     t_max[i] = h.t;
                     self.best[i] = Some(PacketHit {
@@ -137,8 +223,7 @@ impl Closest<'_> {
 /// An occlusion query in progress (see [`Closest`]).
 struct Occluded<'a> {
     geometry: &'a SceneGeometry,
-    rays: &'a [Option<Ray>; PACKET],
-    lane_rays: &'a LaneRays,
+    rays: &'a LaneRays,
     tri: [Option<TriangleRay>; PACKET],
 }
 
@@ -148,12 +233,13 @@ impl Occluded<'_> {
     fn test(&mut self, slot: usize, lanes: Lanes, t_max: &[f64; PACKET]) -> Lanes {
         let g = self.geometry;
         if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
-            return self.lane_rays.sphere(s, lanes, t_max).0;
+            return self.rays.sphere(s, lanes, t_max).0;
         }
         lanes_of(lanes).fold(0, |hit, i| {
-            let occluded = self.rays[i]
-                .as_ref()
-                .is_some_and(|ray| g.test_prim(slot, ray, &mut self.tri[i], t_max[i]).is_some());
+            let ray = self.rays.ray(i);
+            let occluded = g
+                .test_prim(slot, &ray, &mut self.tri[i], t_max[i])
+                .is_some();
             hit | ((occluded as Lanes) << i)
         })
     }
@@ -178,15 +264,24 @@ impl SceneGeometry {
 
     /// The closest hit of every ray of a packet (`None` lanes hit nothing), as the
     /// primitive's slot and its hit; [`packet_hit_record`](Self::packet_hit_record) makes
-    /// the surface record of one, so the kernel moves 24 bytes per lane, not a record.
+    /// the surface record of one.
     #[inline(always)]
     pub fn intersect_packet(&self, rays: &[Option<Ray>; PACKET]) -> [Option<PacketHit>; PACKET] {
+        self.intersect_lanes(&LaneRays::from_rays(rays))
+    }
+
+    /// [`intersect_packet`](Self::intersect_packet) for rays already in lanes.
+    #[inline(always)]
+    pub fn intersect_lanes(&self, rays: &LaneRays) -> [Option<PacketHit>; PACKET] {
         let mut best: [Option<PacketHit>; PACKET] = [None; PACKET];
+        let lanes = rays.lanes;
+        if lanes == 0 {
+            return best;
+        }
         if !self.packet_traversal() {
-            for (b, ray) in best.iter_mut().zip(rays) {
-                *b = ray
-                    .as_ref()
-                    .and_then(|r| self.closest_slot(r))
+            for i in lanes_of(lanes) {
+                best[i] = self
+                    .closest_slot(&rays.ray(i))
                     .map(|(slot, hit)| PacketHit {
                         slot: slot as u32,
                         hit,
@@ -194,16 +289,10 @@ impl SceneGeometry {
             }
             return best;
         }
-        let lane_rays = LaneRays::new(rays);
-        let lanes = lane_rays.lanes;
-        if lanes == 0 {
-            return best;
-        }
-        let mut t_max = lane_rays.t_max;
+        let mut t_max = rays.t_max.0;
         let mut q = Closest {
             geometry: self,
             rays,
-            lane_rays: &lane_rays,
             best,
             tri: [None; PACKET],
         };
@@ -215,7 +304,7 @@ impl SceneGeometry {
                 }
             }
             None => {
-                let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
+                let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
                 self.bvh
                     .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
                         q.test(slot, lanes, t_max)
@@ -233,26 +322,88 @@ impl SceneGeometry {
         self.hit_record(hit.slot as usize, ray, hit.hit, detail)
     }
 
+    /// The surface records of the hits `hits` of `rays` (found by
+    /// [`intersect_lanes`](Self::intersect_lanes)) in lanes: spheres hit by several lanes
+    /// eight lanes at a time, every other hit lane by lane.
+    #[inline(always)]
+    pub fn hit_lanes(&self, rays: &LaneRays, hits: &[Option<PacketHit>; PACKET]) -> HitLanes {
+        let zero = LVec3::zero();
+        let mut out = HitLanes {
+            t: F64x8::zero(),
+            p: zero,
+            ng: zero,
+            ns: zero,
+            dpdu: zero,
+            dpdv: zero,
+            uv: [[0.0; PACKET]; 2],
+            shape: [0; PACKET],
+            prim: [0; PACKET],
+            lanes: 0,
+        };
+        let mut todo: Lanes = (0..PACKET).fold(0, |s, i| s | ((hits[i].is_some() as Lanes) << i));
+        out.lanes = todo;
+        let shape_of = |i: usize| hits[i].map_or(0, |h| self.prims[h.slot as usize].shape);
+        while todo != 0 {
+            let first = todo.trailing_zeros() as usize;
+            let shape = shape_of(first);
+            let group = lanes_of(todo)
+                .filter(|&i| shape_of(i) == shape)
+                .fold(0, |s, i| s | (1 << i));
+            todo &= !group;
+            match &self.shapes[shape as usize] {
+                Shape::Sphere(sphere) if group.count_ones() > 1 => {
+                    let t = F64x8::from_fn(|i| hits[i].map_or(0.0, |h| h.hit.t));
+                    let (p, n, dpdu, _) = sphere.shading_hit_lanes(rays.o, rays.d, t);
+                    let m = M64x8::from_bits(group as u32);
+                    out.t = F64x8::select(m, t, out.t);
+                    out.p = LVec3::select(m, p, out.p);
+                    out.ng = LVec3::select(m, n, out.ng);
+                    out.ns = LVec3::select(m, n, out.ns);
+                    out.dpdu = LVec3::select(m, dpdu, out.dpdu);
+                    for i in lanes_of(group) {
+                        out.shape[i] = shape;
+                    }
+                }
+                _ => {
+                    for i in lanes_of(group) {
+                        let h = hits[i].expect("a hit lane");
+                        let rec = self.hit_record(
+                            h.slot as usize,
+                            &rays.ray(i),
+                            h.hit,
+                            HitDetail::Shading,
+                        );
+                        out.set(i, &rec);
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// [`occluded_ray`](Self::occluded_ray) for every ray of a packet: the occluded lanes
     /// (`None` lanes are not).
     #[inline(always)]
     pub fn occluded_packet(&self, rays: &[Option<Ray>; PACKET]) -> Lanes {
-        if !self.packet_traversal() {
-            return (0..PACKET).fold(0, |set, i| {
-                let occluded = rays[i].as_ref().is_some_and(|r| self.occluded_ray(r));
-                set | ((occluded as Lanes) << i)
-            });
-        }
-        let lane_rays = LaneRays::new(rays);
-        let lanes = lane_rays.lanes;
+        self.occluded_lanes(&LaneRays::from_rays(rays))
+    }
+
+    /// [`occluded_packet`](Self::occluded_packet) for rays already in lanes.
+    #[inline(always)]
+    pub fn occluded_lanes(&self, rays: &LaneRays) -> Lanes {
+        let lanes = rays.lanes;
         if lanes == 0 {
             return 0;
         }
-        let t_max = lane_rays.t_max;
+        if !self.packet_traversal() {
+            return lanes_of(lanes).fold(0, |set, i| {
+                set | ((self.occluded_ray(&rays.ray(i)) as Lanes) << i)
+            });
+        }
+        let t_max = rays.t_max.0;
         let mut q = Occluded {
             geometry: self,
             rays,
-            lane_rays: &lane_rays,
             tri: [None; PACKET],
         };
         let mut test = |slot, lanes| q.test(slot, lanes, &t_max);
@@ -268,7 +419,7 @@ impl SceneGeometry {
                 lanes & !left
             }
             None => {
-                let pb = PacketBox::new(&lane_rays.o, &lane_rays.d);
+                let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
                 self.bvh.any_hit_packet(&pb, lanes, &t_max, test)
             }
         }

@@ -1,0 +1,188 @@
+//! Eight camera samples' numbers at once, for the render kernel: each lane asks for its own
+//! dimension (the lanes' paths are at different vertices), and the values are exactly those
+//! of the lane's [`SampleStream`], computed by the same hashes written once over 32-bit lanes
+//! ([`short_index_point`], [`independent_point`]): eight Sobol points cost about what one
+//! costs lane by lane, in AVX2 `vpmulld`s, shifts and logic.
+//!
+//! A lane's numbers are computed in lanes when its sample has a lane form — a Sobol sample
+//! whose index has at most 32 bits (every image up to 65536² pixels at up to 2^32 / pixels
+//! samples), or any independent sample — and otherwise read from its stream (stratified
+//! samples, Sobol beyond 32 index bits).
+
+use super::sobol::{short_index_point, DimSeeds};
+use super::{independent_point, Layout, PixelSampler, SampleStream};
+use facette_bsdf::lanes::{Bits32, Real, U32x8};
+
+/// The dimensions whose Sobol seeds are tabulated per render (a path of up to 36 vertices
+/// at 7 dimensions each); deeper dimensions hash their seeds lane by lane.
+pub(crate) const TABULATED_DIMENSIONS: u32 = 256;
+
+/// Eight camera samples' sampler state: two words per lane (a Sobol sample's reversed
+/// index; an independent sample's key), and the lanes that have them.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SampleLanes {
+    words: [[u32; 8]; 2],
+    /// Lane i has a lane form where bit i is set.
+    fast: u8,
+}
+
+impl SampleLanes {
+    /// Lane `i` takes the state of `stream`.
+    #[inline]
+    pub(crate) fn set(&mut self, i: usize, sampler: &PixelSampler, stream: &SampleStream) {
+        match sampler.lane_words(stream) {
+            Some(w) => {
+                self.words[0][i] = w[0];
+                self.words[1][i] = w[1];
+                self.fast |= 1 << i;
+            }
+            None => self.fast &= !(1 << i),
+        }
+    }
+}
+
+impl PixelSampler {
+    /// The lane form of a stream's sample, where it has one.
+    #[inline]
+    fn lane_words(&self, stream: &SampleStream) -> Option<[u32; 2]> {
+        match &stream.pattern {
+            super::Pattern::Sobol(z) => z.lane_word().map(|w| [w, 0]),
+            super::Pattern::Independent { key } => Some(super::split(*key)),
+            super::Pattern::Stratified(_) => None,
+        }
+    }
+
+    /// Each lane of `active`'s value of its dimension `dims[i]` (and of `dims[i] + 1` as the
+    /// second coordinate where `pair`): the values of `streams[i].get_1d` / `get_2d` at that
+    /// dimension, in lanes of `S` (never 1). Inactive lanes hold a harmless ½.
+    #[inline(always)]
+    pub(crate) fn get_lanes<S: Real>(
+        &self,
+        lanes: &SampleLanes,
+        streams: &mut [SampleStream],
+        dims: U32x8,
+        active: u8,
+        pair: bool,
+    ) -> (S, S) {
+        let words = |k: usize| U32x8(lanes.words[k]);
+        let (x, y) = match &self.layout {
+            Layout::Sobol(z) if !self.dim_seeds.is_empty() => {
+                let seeds = |i: usize| {
+                    let d = dims.lane(i);
+                    match self.dim_seeds.get(d as usize) {
+                        Some(s) => *s,
+                        None => DimSeeds::new(z.common_key(), d),
+                    }
+                };
+                let s: [DimSeeds; 8] = std::array::from_fn(seeds);
+                let seeds = [
+                    U32x8::from_fn(|i| s[i].field),
+                    U32x8::from_fn(|i| s[i].s0),
+                    U32x8::from_fn(|i| s[i].s1),
+                ];
+                short_index_point(words(0), z.index_bits(), seeds, pair)
+            }
+            Layout::Independent => independent_point([words(0), words(1)], dims),
+            _ => (U32x8::splat(1 << 31), U32x8::splat(1 << 31)),
+        };
+        let (mut x, mut y): (S, S) = (x.unit(), y.unit());
+        let slow = active & !lanes.fast;
+        if slow != 0 {
+            // Stream values are exact 32-bit fractions in f64: cut to S's precision below 1.
+            let below_one = 1.0 - (-(S::DIGITS as f64)).exp2();
+            let mut fx = [0.5; 8];
+            let mut fy = [0.5; 8];
+            for i in (0..8).filter(|i| slow & (1 << i) != 0) {
+                let st = &mut streams[i];
+                st.set_dimension(dims.lane(i));
+                if pair {
+                    let v = st.get_2d();
+                    (fx[i], fy[i]) = (v.x, v.y);
+                } else {
+                    fx[i] = st.get_1d();
+                }
+            }
+            let fast = lanes.fast;
+            let patch = |v: S, f: &[f64; 8]| {
+                S::from_fn(|i| {
+                    if fast & (1 << i) != 0 {
+                        v.lane(i)
+                    } else {
+                        f[i]
+                    }
+                })
+                .min(S::splat(below_one))
+            };
+            x = patch(x, &fx);
+            y = patch(y, &fy);
+        }
+        (x, y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::SamplerKind;
+    use facette_bsdf::lanes::{F32x8, F64x8};
+
+    /// Every lane's value is its stream's, to the bit in f64 lanes and to f32 rounding (never
+    /// 1) in f32 lanes, for lanes at different dimensions, inside and beyond the tabulated
+    /// ones, for every kind and for a Sobol index too wide for the lane form.
+    #[test]
+    fn lanes_draw_what_their_streams_draw() {
+        let layouts = [
+            (SamplerKind::Sobol, 64, 48, 64),
+            (SamplerKind::Sobol, 1 << 17, 4, 1 << 12),
+            (SamplerKind::Independent, 64, 48, 64),
+            (SamplerKind::Stratified, 64, 48, 64),
+        ];
+        for (kind, w, h, spp) in layouts {
+            let sampler = PixelSampler::new(kind, 9, w, h, spp);
+            let wide = kind == SamplerKind::Sobol && w > 65536;
+            for round in 0..64u32 {
+                let mut streams: Vec<SampleStream> = (0..8)
+                    .map(|i| {
+                        let x = (round as usize * 7 + i * 13) % w;
+                        let y = (round as usize + i) % h;
+                        sampler.stream(x, y, ((round + i as u32) % spp as u32) as u64)
+                    })
+                    .collect();
+                let mut lanes = SampleLanes::default();
+                for (i, st) in streams.iter().enumerate() {
+                    lanes.set(i, &sampler, st);
+                }
+                let expect_fast = if kind == SamplerKind::Stratified || wide {
+                    0
+                } else {
+                    0xff
+                };
+                assert_eq!(lanes.fast, expect_fast, "{kind:?} {w}");
+                let dims = U32x8::from_fn(|i| (round * 5 + i as u32 * 37) % 300);
+                for pair in [false, true] {
+                    let active = 0b1011_1101;
+                    let (x, y) =
+                        sampler.get_lanes::<F64x8>(&lanes, &mut streams, dims, active, pair);
+                    let (x32, y32) =
+                        sampler.get_lanes::<F32x8>(&lanes, &mut streams, dims, active, pair);
+                    for i in (0..8).filter(|i| active & (1 << i) != 0) {
+                        let mut st = streams[i].clone();
+                        st.set_dimension(dims.lane(i));
+                        let (ex, ey) = if pair {
+                            let v = st.get_2d();
+                            (v.x, v.y)
+                        } else {
+                            (st.get_1d(), 0.0)
+                        };
+                        assert_eq!(x.lane(i).to_bits(), ex.to_bits(), "{kind:?} lane {i}");
+                        assert!((x32.lane(i) - ex).abs() < 1e-7 && x32.lane(i) < 1.0);
+                        if pair {
+                            assert_eq!(y.lane(i).to_bits(), ey.to_bits(), "{kind:?} lane {i}");
+                            assert!((y32.lane(i) - ey).abs() < 1e-7 && y32.lane(i) < 1.0);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
