@@ -420,8 +420,8 @@ impl Kernel<'_> {
     /// Adds `beta · le · w` to the lanes of `set`.
     #[inline(always)]
     fn add_radiance<S: Real>(paths: &mut Paths<S>, set: Lanes, le: &Rgb<S>, w: S) {
-        for c in 0..3 {
-            paths.l[c] = merge(set, paths.l[c] + paths.beta[c] * le[c] * w, paths.l[c]);
+        for ((l, beta), le) in paths.l.iter_mut().zip(&paths.beta).zip(le) {
+            *l = merge(set, *l + *beta * *le * w, *l);
         }
     }
 
@@ -869,8 +869,8 @@ impl Kernel<'_> {
                 let s = model.sample(wo, u_lobe, u0, u1);
                 let m = mask::<S>(group);
                 wi = LVec3::select(m, s.wi, wi);
-                for c in 0..3 {
-                    weight[c] = merge(group, s.weight[c], weight[c]);
+                for (w, sw) in weight.iter_mut().zip(s.weight) {
+                    *w = merge(group, sw, *w);
                 }
                 pdf = merge(group, s.pdf, pdf);
                 eta = merge(group, s.eta, eta);
@@ -914,8 +914,8 @@ impl Kernel<'_> {
         if go == 0 {
             return;
         }
-        for c in 0..3 {
-            paths.beta[c] = merge(go, paths.beta[c] * weight[c], paths.beta[c]);
+        for (beta, w) in paths.beta.iter_mut().zip(weight) {
+            *beta = merge(go, *beta * w, *beta);
         }
         paths.delta_prev = (paths.delta_prev & !go) | (delta & go);
         paths.prev_pdf = merge(go, pdf, paths.prev_pdf);

@@ -126,8 +126,8 @@ mod tests {
     use crate::sampler::SamplerKind;
     use facette_bsdf::lanes::{F32x8, F64x8};
 
-    /// Every lane's value is its stream's, to the bit in f64 lanes and to f32 rounding (never
-    /// 1) in f32 lanes, for lanes at different dimensions, inside and beyond the tabulated
+    /// Every lane's value is its stream's, to the bit in f64 lanes and to f32 rounding (and
+    /// never 1) in f32 lanes, for lanes at different dimensions, inside and beyond the tabulated
     /// ones, for every kind and for a Sobol index too wide for the lane form.
     #[test]
     fn lanes_draw_what_their_streams_draw() {
