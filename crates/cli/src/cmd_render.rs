@@ -63,9 +63,10 @@ pub struct RenderArgs {
     /// Sobol in Morton order, the default), `independent` or `stratified`.
     #[arg(long, value_name = "NAME", value_parser = parse_sampler)]
     sampler: Option<SamplerKind>,
-    /// Render kernel (overrides the scene's `[integrator] kernel`): `scalar` (one camera
-    /// sample at a time, the default) or `packet` (eight in flight per thread, materials
-    /// in f32 lanes; see docs/performance.md).
+    /// Render kernel (overrides the scene's `[integrator] kernel`): `auto` (the default:
+    /// `packet`, or `scalar` for a hierarchy too large to traverse as packets), `scalar`
+    /// (one camera sample at a time, f64) or `packet` (eight in flight per thread,
+    /// materials in f32 lanes; see docs/performance.md).
     #[arg(long, value_name = "NAME", value_parser = parse_kernel)]
     kernel: Option<Kernel>,
     /// Render part K of N of the samples (K from 0) and write the exact partial result to

@@ -232,7 +232,10 @@ fn render_in_pool(
         // Ray differentials only serve texture and glint footprints.
         footprints: scene.materials.iter().any(|m| m.reads_surface_details()),
     };
-    let kernel = opts.kernel.unwrap_or(scene.integrator.kernel);
+    let kernel = opts
+        .kernel
+        .unwrap_or(scene.integrator.kernel)
+        .resolve(&scene.geometry);
     let sampler = PixelSampler::new(
         opts.sampler.unwrap_or(scene.film.sampler),
         opts.seed,
@@ -255,7 +258,8 @@ fn render_in_pool(
                 let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
                 let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
                 match kernel {
-                    Kernel::Scalar => {
+                    // `resolve` never gives `Auto`.
+                    Kernel::Scalar | Kernel::Auto => {
                         for y in y0..y1 {
                             // Checked per row: a pass of many samples is stopped promptly;
                             // the rows left out keep the samples of the earlier passes.

@@ -12,8 +12,10 @@ pub mod packet;
 /// A render kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Kernel {
-    /// One camera sample at a time, f64.
+    /// The faster of the two for the scene ([`Kernel::resolve`]).
     #[default]
+    Auto,
+    /// One camera sample at a time, f64.
     Scalar,
     /// Eight camera samples per thread in lock-step, materials in f32 lanes.
     Packet,
@@ -21,7 +23,7 @@ pub enum Kernel {
 
 impl Kernel {
     /// The names in scene files and on the command line, in declaration order.
-    pub const NAMES: [&'static str; 2] = ["scalar", "packet"];
+    pub const NAMES: [&'static str; 3] = ["auto", "scalar", "packet"];
 
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
@@ -30,9 +32,26 @@ impl Kernel {
     /// The kernel of an exact lowercase name.
     pub fn parse(s: &str) -> Option<Kernel> {
         match s {
+            "auto" => Some(Kernel::Auto),
             "scalar" => Some(Kernel::Scalar),
             "packet" => Some(Kernel::Packet),
             _ => None,
+        }
+    }
+}
+
+impl Kernel {
+    /// The kernel that renders: `Auto` is the packet kernel unless the scene's hierarchy is
+    /// too large to be traversed as packets
+    /// ([`PACKET_TRAVERSAL_MAX_NODES`](crate::geometry::scene_geometry::PACKET_TRAVERSAL_MAX_NODES)).
+    /// There the packet kernel queries the geometry lane by lane and gains nothing on it,
+    /// and on `scenes/mesh.toml` (1 M triangles) it rendered at 0.9× the scalar kernel's
+    /// speed, against 1.3–2.5× on the bench spheres (docs/performance.md).
+    pub fn resolve(self, geometry: &crate::geometry::SceneGeometry) -> Kernel {
+        match self {
+            Kernel::Auto if geometry.packet_traversal() => Kernel::Packet,
+            Kernel::Auto => Kernel::Scalar,
+            k => k,
         }
     }
 }
