@@ -166,21 +166,32 @@ impl Camera {
         let sx = one - R::splat(2.0) * x / R::splat(self.width as f64);
         let sy = one - R::splat(2.0) * y / R::splat(self.height as f64);
         let dl = LVec3::new(sx * R::splat(self.tan_x), sy * R::splat(self.tan_y), one);
-        let axes = |v: LVec3<R>| {
-            let col = |c: glam::DVec3| LVec3::new(R::splat(c.x), R::splat(c.y), R::splat(c.z));
-            let res = col(self.axes.x_axis).scale(v.x);
-            let res = res + col(self.axes.y_axis).scale(v.y);
-            res + col(self.axes.z_axis).scale(v.z)
-        };
+        // A function, not a closure: closures are compiled for the baseline CPU, out of
+        // the render kernel's AVX2 code.
+        #[inline(always)]
+        fn to_axes<R: Real>(m: &glam::DMat3, v: LVec3<R>) -> LVec3<R> {
+            let (x, y, z) = (m.x_axis, m.y_axis, m.z_axis);
+            LVec3::new(
+                R::splat(x.x) * v.x + R::splat(y.x) * v.y + R::splat(z.x) * v.z,
+                R::splat(x.y) * v.x + R::splat(y.y) * v.y + R::splat(z.y) * v.z,
+                R::splat(x.z) * v.x + R::splat(y.z) * v.y + R::splat(z.z) * v.z,
+            )
+        }
         if self.lens_radius > 0.0 {
             let (lx, ly) = square_to_disk_concentric_lanes(u_lens.0, u_lens.1);
             let r = R::splat(self.lens_radius);
             let lens = LVec3::new(lx * r, ly * r, R::zero());
             let origin = self.to_world.point_lanes(lens);
             let focus = dl.scale(R::splat(self.focus_distance) / dl.z);
-            (origin, axes(focus - lens).normalize().normalize())
+            (
+                origin,
+                to_axes(&self.axes, focus - lens).normalize().normalize(),
+            )
         } else {
-            (LVec3::splat(self.origin), axes(dl).normalize().normalize())
+            (
+                LVec3::splat(self.origin),
+                to_axes(&self.axes, dl).normalize().normalize(),
+            )
         }
     }
 

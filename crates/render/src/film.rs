@@ -57,12 +57,18 @@ impl Filter {
                 // Separable truncated Gaussian by inverting the normal CDF restricted to
                 // [−radius, radius]; Giles' erfinv (1e-7 relative) is ample for placing a
                 // sample within a pixel and 5× cheaper than the refined one.
-                let k = R::splat(stddev * std::f64::consts::SQRT_2);
-                let f = |x: R| {
+                // A function, not a closure: a closure is compiled on its own, for the
+                // baseline CPU, and called out of line from the render kernel's AVX2 code.
+                #[inline(always)]
+                fn offset<R: Real>(x: R, stddev: f64, radius: f64, mass: f64) -> R {
                     let y = (R::splat(2.0) * x - R::one()) * R::splat(mass);
+                    let k = R::splat(stddev * std::f64::consts::SQRT_2);
                     (k * erfinv_approx_lanes(y)).clamp(-radius, radius)
-                };
-                (f(u0), f(u1))
+                }
+                (
+                    offset(u0, stddev, radius, mass),
+                    offset(u1, stddev, radius, mass),
+                )
             }
         }
     }

@@ -26,11 +26,16 @@ pub fn erfinv_approx(y: f64) -> f64 {
 /// where some lane needs it, and selected per lane.
 #[inline(always)]
 pub fn erfinv_approx_lanes<R: Real>(y: R) -> R {
-    let horner = |w: R, c: &[f64]| {
-        c[1..]
-            .iter()
-            .fold(R::splat(c[0]), |p, &k| R::splat(k) + p * w)
-    };
+    // Functions, not closures, so that they inline into the renderer's AVX2 kernel (a
+    // closure is compiled on its own for the baseline CPU).
+    #[inline(always)]
+    fn horner<R: Real>(w: R, c: &[f64]) -> R {
+        let mut p = R::splat(c[0]);
+        for &k in &c[1..] {
+            p = R::splat(k) + p * w;
+        }
+        p
+    }
     let w = -((R::one() - y) * (R::one() + y)).ln();
     let central = w.lt(R::splat(5.0));
     let inner = if central.any() {

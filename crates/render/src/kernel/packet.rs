@@ -328,8 +328,10 @@ impl Kernel<'_> {
             return;
         }
         paths.live |= filled;
-        paths.l = paths.l.map(|c| merge(filled, S::zero(), c));
-        paths.beta = paths.beta.map(|c| merge(filled, S::one(), c));
+        for c in 0..3 {
+            paths.l[c] = merge(filled, S::zero(), paths.l[c]);
+            paths.beta[c] = merge(filled, S::one(), paths.beta[c]);
+        }
         paths.delta_prev |= filled;
         paths.prev_pdf = merge(filled, S::zero(), paths.prev_pdf);
         paths.eta_scale = merge(filled, S::one(), paths.eta_scale);

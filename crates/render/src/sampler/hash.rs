@@ -70,18 +70,26 @@ pub(crate) fn laine_karras_lanes<B: Bits32>(x: B, seed: B) -> B {
 /// time. The samplers' chi-square tests check its marginals and neighbouring dimensions.
 #[inline(always)]
 pub(crate) fn pcg4d<B: Bits32>(v: [B; 4]) -> [B; 4] {
-    let mut v = v.map(|c| {
-        c.wrapping_mul(B::splat(1_664_525))
-            .wrapping_add(B::splat(1_013_904_223))
-    });
-    let round = |v: &mut [B; 4]| {
+    // Loops and a function rather than `map` and a closure, so that everything inlines
+    // into the renderer's AVX2 kernel (closures and `map` may be left out of line, compiled
+    // for the baseline CPU).
+    #[inline(always)]
+    fn round<B: Bits32>(v: &mut [B; 4]) {
         v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[3]));
         v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
         v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
         v[3] = v[3].wrapping_add(v[1].wrapping_mul(v[2]));
-    };
+    }
+    let mut v = v;
+    for c in &mut v {
+        *c = c
+            .wrapping_mul(B::splat(1_664_525))
+            .wrapping_add(B::splat(1_013_904_223));
+    }
     round(&mut v);
-    v = v.map(|c| c ^ c.shr(16));
+    for c in &mut v {
+        *c = *c ^ c.shr(16);
+    }
     round(&mut v);
     v
 }

@@ -149,6 +149,7 @@ impl PixelSampler {
     }
 
     /// The stream of one camera sample: a pure function of (seed, pixel, sample_index).
+    #[inline]
     pub fn stream(&self, x: usize, y: usize, sample_index: u64) -> SampleStream {
         // The renderer's seeding since before samplers existed: (y · width + x) as u64
         // (wrapping only where that product overflowed usize anyway).

@@ -295,6 +295,7 @@ impl ZSobol {
     }
 
     /// The state of one camera sample.
+    #[inline]
     pub(crate) fn start(&self, x: usize, y: usize, sample_index: u64) -> ZSobolSample {
         let (x, y) = (x as u64, y as u64);
         // levels ≤ 32, so the in-tile coordinates fit in u32 and the shifts in u64.
@@ -312,10 +313,15 @@ impl ZSobol {
         let index = morton.checked_shl(self.log2_spp).unwrap_or(0) | low;
         // 0, 0, 0 for every pixel of an image that fits: then `key` is one constant per
         // seed and this is exactly the ZSobol design.
-        let key = mix_seed(
-            mix_seed(mix_seed(self.seed ^ ZSOBOL_TAG, tile_x), tile_y),
-            extra,
-        );
+        let key = if (tile_x, tile_y, extra) == (0, 0, 0) {
+            // The same three hashes, made once per render.
+            self.common_key
+        } else {
+            mix_seed(
+                mix_seed(mix_seed(self.seed ^ ZSOBOL_TAG, tile_x), tile_y),
+                extra,
+            )
+        };
         let bits = self.index_bits();
         ZSobolSample {
             layout: *self,
