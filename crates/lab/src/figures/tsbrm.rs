@@ -4,7 +4,7 @@
 //! the qualitative model TSBRM eq. 42 combines with Cook–Torrance (Gaussian D, V-cavity
 //! G, Fresnel of index n_i) — the same specular lobe as IL's.
 
-use super::{at, body_curve, plane_curve, single, Quality, Reproduction};
+use super::{at, body_curve, material, plane_curve, single, Quality, Reproduction};
 use crate::plot::bsdf_data::{light_direction, plane_direction, signed_angles};
 use crate::plot::bsdf_data::{Quantity, Side};
 use crate::plot::{LineChart, Scale, Series};
@@ -194,13 +194,91 @@ pub fn fig18(q: Quality) -> Result<Reproduction, ParamError> {
 }
 
 /// TSBRM Fig. 19: n_i = 1, 1.2, 1.5 at θ_i = 80°, σ = 0.3, K_d = 0.9.
+///
+/// At n_i = 1 Simonot's model is the exact Oren–Nayar integral [TSBRM eq. 27], and ON + CT
+/// is Oren & Nayar's qualitative model alone, which is the constant ρA/π on the whole mirror
+/// side (its B term needs cos Δφ > 0). The figure adds Oren & Nayar's fuller L1
+/// approximation (points) and the numbers compare the three there: the gap at grazing
+/// observation is the qualitative model's, not the interface's (docs/reproduction.md,
+/// ERRATA 17).
 pub fn fig19(q: Quality) -> Result<Reproduction, ParamError> {
-    comparison(
+    let (kd, theta_i, sigma) = (0.9, 80.0, 0.3);
+    let mut r = comparison(
         q,
-        0.9,
-        80.0,
-        &[(1.0, 0.3), (1.2, 0.3), (1.5, 0.3)],
+        kd,
+        theta_i,
+        &[(1.0, sigma), (1.2, sigma), (1.5, sigma)],
         "TSBRM Fig. 19: Simonot vs Oren–Nayar + Cook–Torrance, σ = 0.3",
         |n, _| format!("n_i = {n}"),
-    )
+    )?;
+    let points = q.points();
+    let on = |keys: &str| on_curve(kd, sigma, keys, theta_i, points);
+    let exact = on("model = \"exact\", evaluation = \"quadrature\"")?;
+    let l1 = on("model = \"l1\"")?;
+    let qual = on_ct(kd, 1.0, sigma)?.curve(theta_i, points);
+    for t in [60.0, 80.0, 85.0] {
+        r.numbers.push(format!(
+            "n_i = 1, θ_o = +{t}°: Oren–Nayar exact {:.4}, L1 {:.4}, qualitative {:.4}; exact / qualitative {:.3}, exact / L1 {:.3}",
+            at(&exact, t),
+            at(&l1, t),
+            at(&qual, t),
+            at(&exact, t) / at(&qual, t),
+            at(&exact, t) / at(&l1, t)
+        ));
+    }
+    r.figure.charts[0]
+        .series
+        .push(Series::new("Oren–Nayar L1, n_i = 1", l1, 0).points_only());
+    Ok(r)
+}
+
+/// An Oren–Nayar model (`keys`: its `model` and options) in the incidence plane.
+fn on_curve(
+    kd: f64,
+    sigma: f64,
+    keys: &str,
+    theta_i: f64,
+    points: usize,
+) -> Result<Vec<(f64, f64)>, ParamError> {
+    let m = material(&format!(
+        "{{type = \"oren-nayar\", reflectance = {kd}, sigma = {sigma}, {keys}}}"
+    ))?;
+    Ok(plane_curve(
+        m.as_ref(),
+        theta_i,
+        Side::Reflection,
+        Quantity::F,
+        points,
+        1,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// TSBRM Fig. 19 at n_i = 1, θ_i = 80°, σ = 0.3: ON's qualitative model is flat on the
+    /// mirror side and overestimates the exact integral [TSBRM eq. 27] about 4× at
+    /// θ_o = +85°; the L1 model keeps part of the fall-off (about 2× too high); the three
+    /// agree in backscattering.
+    #[test]
+    fn qualitative_oren_nayar_is_flat_on_the_mirror_side_and_4x_high_at_grazing() {
+        let (kd, sigma, theta_i, points) = (0.9, 0.3, 80.0, 181);
+        let exact = on_curve(
+            kd,
+            sigma,
+            "model = \"exact\", evaluation = \"quadrature\"",
+            theta_i,
+            points,
+        )
+        .unwrap();
+        let l1 = on_curve(kd, sigma, "model = \"l1\"", theta_i, points).unwrap();
+        let qual = on_ct(kd, 1.0, sigma).unwrap().curve(theta_i, points);
+        let r = |a: &[(f64, f64)], b: &[(f64, f64)], t| at(a, t) / at(b, t);
+        assert!((at(&qual, 85.0) / at(&qual, 1.0) - 1.0).abs() < 1e-12);
+        assert!((0.22..0.30).contains(&r(&exact, &qual, 85.0)));
+        assert!((0.38..0.52).contains(&r(&exact, &l1, 85.0)));
+        assert!((r(&exact, &qual, -80.0) - 1.0).abs() < 0.03);
+        assert!((r(&exact, &l1, -80.0) - 1.0).abs() < 0.03);
+    }
 }
