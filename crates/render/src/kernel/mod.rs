@@ -38,15 +38,14 @@ impl Kernel {
             _ => None,
         }
     }
-}
 
-impl Kernel {
     /// The kernel that renders: `Auto` is the packet kernel unless the scene's hierarchy is
     /// too large to be traversed as packets
     /// ([`PACKET_TRAVERSAL_MAX_NODES`](crate::geometry::scene_geometry::PACKET_TRAVERSAL_MAX_NODES)).
-    /// There the packet kernel queries the geometry lane by lane and gains nothing on it,
-    /// and on `scenes/mesh.toml` (1 M triangles) it rendered at 0.9× the scalar kernel's
-    /// speed, against 1.3–2.5× on the bench spheres (docs/performance.md).
+    /// There the packet kernel queries the geometry lane by lane and gains nothing: on
+    /// `scenes/mesh.toml` (1 M triangles) the two render at the same speed (0.90 and 0.91
+    /// Msamples/s), against 1.3–2.6× for the packet kernel on the bench spheres
+    /// (docs/performance.md).
     pub fn resolve(self, geometry: &crate::geometry::SceneGeometry) -> Kernel {
         match self {
             Kernel::Auto if geometry.packet_traversal() => Kernel::Packet,
