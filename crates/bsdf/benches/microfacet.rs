@@ -87,9 +87,80 @@ fn distributions(c: &mut Criterion) {
     bench_distribution(c, "phong", Ndf::Phong(Phong::new(20.0).unwrap()));
 }
 
+/// The renderer's f32 lanes: 32 packets of 8 visible-normal samples per iteration, in a
+/// function compiled for AVX2 + FMA as the render kernel is (the baseline build where the
+/// CPU lacks them); criterion reports ns per sample.
+mod lanes {
+    use facette_bsdf::lanes::{F32x8, LVec3, Real};
+    use facette_bsdf::microfacet::{Beckmann, Ggx};
+    use facette_bsdf::{Vec2, Vec3};
+
+    pub struct Packets {
+        pub dirs: Vec<LVec3<F32x8>>,
+        pub us: Vec<(F32x8, F32x8)>,
+    }
+
+    pub fn packets(dirs: &[Vec3], us: &[Vec2]) -> Packets {
+        Packets {
+            dirs: dirs.chunks(8).map(|c| LVec3::from_fn(|i| c[i])).collect(),
+            us: us
+                .chunks(8)
+                .map(|c| (F32x8::from_fn(|i| c[i].x), F32x8::from_fn(|i| c[i].y)))
+                .collect(),
+        }
+    }
+
+    macro_rules! visible_sampler {
+        ($name:ident, $avx2:ident, $ndf:ty) => {
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn $avx2(d: &$ndf, p: &Packets) -> f64 {
+                let mut acc = F32x8::zero();
+                for (v, &(u0, u1)) in p.dirs.iter().zip(&p.us) {
+                    acc = acc + d.sample_visible_lanes(*v, u0, u1).z;
+                }
+                acc.lane(0)
+            }
+
+            pub fn $name(d: &$ndf, p: &Packets) -> f64 {
+                #[cfg(target_arch = "x86_64")]
+                if std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+                {
+                    // SAFETY: the CPU has the features the function is compiled for.
+                    return unsafe { $avx2(d, p) };
+                }
+                let mut acc = F32x8::zero();
+                for (v, &(u0, u1)) in p.dirs.iter().zip(&p.us) {
+                    acc = acc + d.sample_visible_lanes(*v, u0, u1).z;
+                }
+                acc.lane(0)
+            }
+        };
+    }
+    visible_sampler!(beckmann_visible, beckmann_visible_avx2, Beckmann);
+    visible_sampler!(ggx_visible, ggx_visible_avx2, Ggx);
+}
+
+fn lane_kernels(c: &mut Criterion) {
+    let (dirs, us) = inputs();
+    let p = lanes::packets(&dirs, &us);
+    let mut g = c.benchmark_group("f32x8");
+    g.throughput(Throughput::Elements(256));
+    let b = Beckmann::new(0.3, 0.5).unwrap();
+    g.bench_function("beckmann sample_visible", |bench| {
+        bench.iter(|| lanes::beckmann_visible(black_box(&b), black_box(&p)))
+    });
+    let gx = Ggx::new(0.3, 0.5).unwrap();
+    g.bench_function("ggx sample_visible", |bench| {
+        bench.iter(|| lanes::ggx_visible(black_box(&gx), black_box(&p)))
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(std::time::Duration::from_millis(300)).measurement_time(std::time::Duration::from_secs(1));
-    targets = distributions
+    targets = distributions, lane_kernels
 }
 criterion_main!(benches);

@@ -36,7 +36,7 @@ pub(crate) use lanewise;
 /// bits set or clear per lane, the layout of a vector compare), with the transcendental
 /// methods (`sin_cos`, `exp`, `ln`) given as `$special`.
 macro_rules! array_lanes {
-    ($real:ident, $mask:ident, $elem:ty, $bits:ty, $n:literal, tiny = $tiny:expr, { $($special:tt)* }) => {
+    ($real:ident, $mask:ident, $elem:ty, $bits:ty, $n:literal, tiny = $tiny:expr, cells = $cells:ident, { $($special:tt)* }) => {
         macro_rules! binop {
             ($tr:ident, $f:ident, $op:tt) => {
                 impl $tr for $real {
@@ -150,6 +150,22 @@ macro_rules! array_lanes {
             #[inline(always)]
             fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
                 $real(std::array::from_fn(|i| f(i) as $elem))
+            }
+            /// One load of the cell's four numbers per lane, transposed into four lane values.
+            #[inline(always)]
+            fn gather4(table: &$crate::lanes::CellTable, cell: Self) -> [Self; 4] {
+                let cells = table.$cells();
+                // One vector conversion; a negative or NaN lane indexes out of bounds (a
+                // panic, never a wrong cell).
+                let index = lanewise!(cell.0, |a| a as i32);
+                let mut out = [[0.0 as $elem; $n]; 4];
+                for i in 0..$n {
+                    let c = cells[index[i] as u32 as usize];
+                    for k in 0..4 {
+                        out[k][i] = c[k];
+                    }
+                }
+                [$real(out[0]), $real(out[1]), $real(out[2]), $real(out[3])]
             }
             #[inline(always)]
             fn sqrt(self) -> Self {

@@ -41,105 +41,121 @@ impl F32x8 {
     }
 }
 
-array_lanes!(F32x8, M32x8, f32, u32, 8, tiny = 1e-30, {
-    /// Cephes `sinf`/`cosf`: the quadrant k = round(x·2/π), the remainder
-    /// z = |x| − kπ/2 in three parts, and the two minimax polynomials on [−π/4, π/4].
-    /// Accurate to about 1 ulp for |x| < 2¹³ (the models pass angles in [0, 2π]).
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let ax = self.abs();
-        let (k, ki) = (ax * F32x8::splat(std::f64::consts::FRAC_2_PI)).round_with_int();
-        let z = ((ax - k * F32x8::splat(1.570_312_5)) - k * F32x8::splat(4.837_512_969_970_703e-4))
-            - k * F32x8::splat(7.549_789_954_891_882e-8);
-        let zz = z * z;
-        let cos_p = ((F32x8::splat(2.443_315_711_809_948e-5) * zz
-            - F32x8::splat(1.388_731_625_493_765e-3))
-            * zz
-            + F32x8::splat(4.166_664_568_298_827e-2))
-            * zz
-            * zz
-            - F32x8::splat(0.5) * zz
-            + F32x8::one();
-        let sin_p = ((F32x8::splat(-1.951_529_589_1e-4) * zz + F32x8::splat(8.332_160_873_6e-3))
-            * zz
-            - F32x8::splat(1.666_665_461_1e-1))
-            * zz
-            * z
-            + z;
-        let swap = M32x8(lanewise!(ki.0, |q| if q & 1 != 0 { !0u32 } else { 0 }));
-        let s = Self::select(swap, cos_p, sin_p);
-        let c = Self::select(swap, sin_p, cos_p);
-        // Sign bits: sin is negative in quadrants 2 and 3 (and odd in x), cos in 1 and 2.
-        let neg = self.bits();
-        let mut sb = s.bits();
-        let mut cb = c.bits();
-        for i in 0..8 {
-            let q = ki.0[i] as u32;
-            sb[i] ^= ((q & 2) << 30) ^ (neg[i] & 0x8000_0000);
-            cb[i] ^= (q.wrapping_add(1) & 2) << 30;
+array_lanes!(
+    F32x8,
+    M32x8,
+    f32,
+    u32,
+    8,
+    tiny = 1e-30,
+    cells = f32_cells,
+    {
+        /// Cephes `sinf`/`cosf`: the quadrant k = round(x·2/π), the remainder
+        /// z = |x| − kπ/2 in three parts, and the two minimax polynomials on [−π/4, π/4].
+        /// Accurate to about 1 ulp for |x| < 2¹³ (the models pass angles in [0, 2π]).
+        #[inline(always)]
+        fn sin_cos(self) -> (Self, Self) {
+            let ax = self.abs();
+            let (k, ki) = (ax * F32x8::splat(std::f64::consts::FRAC_2_PI)).round_with_int();
+            let z = ((ax - k * F32x8::splat(1.570_312_5))
+                - k * F32x8::splat(4.837_512_969_970_703e-4))
+                - k * F32x8::splat(7.549_789_954_891_882e-8);
+            let zz = z * z;
+            let cos_p = ((F32x8::splat(2.443_315_711_809_948e-5) * zz
+                - F32x8::splat(1.388_731_625_493_765e-3))
+                * zz
+                + F32x8::splat(4.166_664_568_298_827e-2))
+                * zz
+                * zz
+                - F32x8::splat(0.5) * zz
+                + F32x8::one();
+            let sin_p =
+                ((F32x8::splat(-1.951_529_589_1e-4) * zz + F32x8::splat(8.332_160_873_6e-3)) * zz
+                    - F32x8::splat(1.666_665_461_1e-1))
+                    * zz
+                    * z
+                    + z;
+            let swap = M32x8(lanewise!(ki.0, |q| if q & 1 != 0 { !0u32 } else { 0 }));
+            let s = Self::select(swap, cos_p, sin_p);
+            let c = Self::select(swap, sin_p, cos_p);
+            // Sign bits: sin is negative in quadrants 2 and 3 (and odd in x), cos in 1 and 2.
+            let neg = self.bits();
+            let mut sb = s.bits();
+            let mut cb = c.bits();
+            for i in 0..8 {
+                let q = ki.0[i] as u32;
+                sb[i] ^= ((q & 2) << 30) ^ (neg[i] & 0x8000_0000);
+                cb[i] ^= (q.wrapping_add(1) & 2) << 30;
+            }
+            (Self::from_bits(sb), Self::from_bits(cb))
         }
-        (Self::from_bits(sb), Self::from_bits(cb))
-    }
 
-    /// Cephes `expf`: e^x = 2ⁿ e^r with n = round(x/ln 2), r in [−ln2/2, ln2/2], and a
-    /// degree-6 polynomial; x is clamped to [−87.3, 88.37] (the normal f32 range).
-    #[inline(always)]
-    fn exp(self) -> Self {
-        let x = self.clamp(-87.3, 88.37);
-        let (n, ni) = (x * F32x8::splat(std::f64::consts::LOG2_E)).round_with_int();
-        let r = x - n * F32x8::splat(0.693_359_375) - n * F32x8::splat(-2.121_944_4e-4);
-        let mut p = F32x8::splat(1.987_569_150_0e-4);
-        for c in [
-            1.398_199_950_7e-3,
-            8.333_451_907_3e-3,
-            4.166_579_589_4e-2,
-            1.666_666_545_9e-1,
-            5.000_000_120_1e-1,
-        ] {
-            p = p * r + F32x8::splat(c);
+        /// ⌊x⌋ lane by lane: one `vroundps` where compiled for AVX (SSE4.1 and up).
+        #[inline(always)]
+        fn floor(self) -> Self {
+            F32x8(lanewise!(self.0, |a| a.floor()))
         }
-        let y = p * r * r + r + F32x8::one();
-        let scale = Self::from_bits(lanewise!(ni.0, |e| ((e + 127) as u32) << 23));
-        let out = y * scale;
-        // A NaN input stays NaN (the clamp above would have turned it into a number).
-        Self::select(self.eq(self), out, self)
-    }
 
-    /// Cephes `logf`: x = m·2ᵉ with m in [√½, √2), ln x = e ln 2 + ln m by a degree-8
-    /// polynomial. ln 0 = −∞, ln of a negative or NaN is NaN, ln ∞ = ∞; subnormal inputs
-    /// are not handled (the models take logarithms of numbers ≥ 1e-30).
-    #[inline(always)]
-    fn ln(self) -> Self {
-        let b = self.bits();
-        let e = lanewise!(b, |v| ((v >> 23) & 0xFF) as i32 - 126);
-        let m = Self::from_bits(lanewise!(b, |v| (v & 0x807F_FFFF) | 0x3F00_0000));
-        // m in [0.5, 1): fold below √½ into [√½, √2) by doubling.
-        let small = m.lt(F32x8::splat(std::f64::consts::FRAC_1_SQRT_2));
-        let ef =
-            F32x8(lanewise!(e, |v| v as f32)) - Self::select(small, F32x8::one(), F32x8::zero());
-        let x = Self::select(small, m + m, m) - F32x8::one();
-        let z = x * x;
-        let mut y = F32x8::splat(7.037_683_629_2e-2);
-        for c in [
-            -1.151_461_031_0e-1,
-            1.167_699_874_0e-1,
-            -1.242_014_084_6e-1,
-            1.424_932_278_7e-1,
-            -1.666_805_766_5e-1,
-            2.000_071_476_5e-1,
-            -2.499_999_399_3e-1,
-            3.333_333_117_4e-1,
-        ] {
-            y = y * x + F32x8::splat(c);
+        /// Cephes `expf`: e^x = 2ⁿ e^r with n = round(x/ln 2), r in [−ln2/2, ln2/2], and a
+        /// degree-6 polynomial; x is clamped to [−87.3, 88.37] (the normal f32 range).
+        #[inline(always)]
+        fn exp(self) -> Self {
+            let x = self.clamp(-87.3, 88.37);
+            let (n, ni) = (x * F32x8::splat(std::f64::consts::LOG2_E)).round_with_int();
+            let r = x - n * F32x8::splat(0.693_359_375) - n * F32x8::splat(-2.121_944_4e-4);
+            let mut p = F32x8::splat(1.987_569_150_0e-4);
+            for c in [
+                1.398_199_950_7e-3,
+                8.333_451_907_3e-3,
+                4.166_579_589_4e-2,
+                1.666_666_545_9e-1,
+                5.000_000_120_1e-1,
+            ] {
+                p = p * r + F32x8::splat(c);
+            }
+            let y = p * r * r + r + F32x8::one();
+            let scale = Self::from_bits(lanewise!(ni.0, |e| ((e + 127) as u32) << 23));
+            let out = y * scale;
+            // A NaN input stays NaN (the clamp above would have turned it into a number).
+            Self::select(self.eq(self), out, self)
         }
-        let y = y * x * z + ef * F32x8::splat(-2.121_944_4e-4) - F32x8::splat(0.5) * z;
-        let out = x + y + ef * F32x8::splat(0.693_359_375);
-        let inf = F32x8::splat(f64::INFINITY);
-        let out = Self::select(self.eq(inf), inf, out);
-        let out = Self::select(self.eq(F32x8::zero()), -inf, out);
-        Self::select(self.ge(F32x8::zero()), out, F32x8::splat(f64::NAN))
+
+        /// Cephes `logf`: x = m·2ᵉ with m in [√½, √2), ln x = e ln 2 + ln m by a degree-8
+        /// polynomial. ln 0 = −∞, ln of a negative or NaN is NaN, ln ∞ = ∞; subnormal inputs
+        /// are not handled (the models take logarithms of numbers ≥ 1e-30).
+        #[inline(always)]
+        fn ln(self) -> Self {
+            let b = self.bits();
+            let e = lanewise!(b, |v| ((v >> 23) & 0xFF) as i32 - 126);
+            let m = Self::from_bits(lanewise!(b, |v| (v & 0x807F_FFFF) | 0x3F00_0000));
+            // m in [0.5, 1): fold below √½ into [√½, √2) by doubling.
+            let small = m.lt(F32x8::splat(std::f64::consts::FRAC_1_SQRT_2));
+            let ef = F32x8(lanewise!(e, |v| v as f32))
+                - Self::select(small, F32x8::one(), F32x8::zero());
+            let x = Self::select(small, m + m, m) - F32x8::one();
+            let z = x * x;
+            let mut y = F32x8::splat(7.037_683_629_2e-2);
+            for c in [
+                -1.151_461_031_0e-1,
+                1.167_699_874_0e-1,
+                -1.242_014_084_6e-1,
+                1.424_932_278_7e-1,
+                -1.666_805_766_5e-1,
+                2.000_071_476_5e-1,
+                -2.499_999_399_3e-1,
+                3.333_333_117_4e-1,
+            ] {
+                y = y * x + F32x8::splat(c);
+            }
+            let y = y * x * z + ef * F32x8::splat(-2.121_944_4e-4) - F32x8::splat(0.5) * z;
+            let out = x + y + ef * F32x8::splat(0.693_359_375);
+            let inf = F32x8::splat(f64::INFINITY);
+            let out = Self::select(self.eq(inf), inf, out);
+            let out = Self::select(self.eq(F32x8::zero()), -inf, out);
+            Self::select(self.ge(F32x8::zero()), out, F32x8::splat(f64::NAN))
+        }
     }
-});
+);
 
 #[cfg(test)]
 mod tests {

@@ -19,21 +19,34 @@ pub struct F64x4(pub [f64; 4]);
 #[repr(C, align(32))]
 pub struct M64x4(pub [u64; 4]);
 
-array_lanes!(F64x4, M64x4, f64, u64, 4, tiny = 1e-300, {
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let sc = lanewise!(self.0, |a| a.sin_cos());
-        (F64x4(sc.map(|p| p.0)), F64x4(sc.map(|p| p.1)))
+array_lanes!(
+    F64x4,
+    M64x4,
+    f64,
+    u64,
+    4,
+    tiny = 1e-300,
+    cells = f64_cells,
+    {
+        #[inline(always)]
+        fn sin_cos(self) -> (Self, Self) {
+            let sc = lanewise!(self.0, |a| a.sin_cos());
+            (F64x4(sc.map(|p| p.0)), F64x4(sc.map(|p| p.1)))
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            F64x4(lanewise!(self.0, |a| a.floor()))
+        }
+        #[inline(always)]
+        fn exp(self) -> Self {
+            F64x4(lanewise!(self.0, |a| a.exp()))
+        }
+        #[inline(always)]
+        fn ln(self) -> Self {
+            F64x4(lanewise!(self.0, |a| a.ln()))
+        }
     }
-    #[inline(always)]
-    fn exp(self) -> Self {
-        F64x4(lanewise!(self.0, |a| a.exp()))
-    }
-    #[inline(always)]
-    fn ln(self) -> Self {
-        F64x4(lanewise!(self.0, |a| a.ln()))
-    }
-});
+);
 
 #[cfg(test)]
 mod tests {

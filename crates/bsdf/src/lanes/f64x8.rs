@@ -20,21 +20,34 @@ pub struct F64x8(pub [f64; 8]);
 #[repr(C, align(64))]
 pub struct M64x8(pub [u64; 8]);
 
-array_lanes!(F64x8, M64x8, f64, u64, 8, tiny = 1e-300, {
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let sc = lanewise!(self.0, |a| a.sin_cos());
-        (F64x8(sc.map(|p| p.0)), F64x8(sc.map(|p| p.1)))
+array_lanes!(
+    F64x8,
+    M64x8,
+    f64,
+    u64,
+    8,
+    tiny = 1e-300,
+    cells = f64_cells,
+    {
+        #[inline(always)]
+        fn sin_cos(self) -> (Self, Self) {
+            let sc = lanewise!(self.0, |a| a.sin_cos());
+            (F64x8(sc.map(|p| p.0)), F64x8(sc.map(|p| p.1)))
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            F64x8(lanewise!(self.0, |a| a.floor()))
+        }
+        #[inline(always)]
+        fn exp(self) -> Self {
+            F64x8(lanewise!(self.0, |a| a.exp()))
+        }
+        #[inline(always)]
+        fn ln(self) -> Self {
+            F64x8(lanewise!(self.0, |a| a.ln()))
+        }
     }
-    #[inline(always)]
-    fn exp(self) -> Self {
-        F64x8(lanewise!(self.0, |a| a.exp()))
-    }
-    #[inline(always)]
-    fn ln(self) -> Self {
-        F64x8(lanewise!(self.0, |a| a.ln()))
-    }
-});
+);
 
 impl M64x8 {
     /// The mask of the set bits of `bits` (lane i set where bit i is).

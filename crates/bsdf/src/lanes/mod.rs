@@ -7,6 +7,7 @@
 //! the f64 [`Distribution`](crate::microfacet::Distribution) methods instantiate.
 
 pub(crate) mod array_lanes;
+mod cell_table;
 mod f32x8;
 mod f64x4;
 mod f64x8;
@@ -15,6 +16,7 @@ mod real;
 mod u32x8;
 mod vec3;
 
+pub use cell_table::CellTable;
 pub use f32x8::{F32x8, M32x8};
 pub use f64x4::{F64x4, M64x4};
 pub use f64x8::{F64x8, M64x8};

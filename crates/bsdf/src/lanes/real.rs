@@ -5,6 +5,7 @@
 //! [`select`](Real::select) on a mask, so the same source serves one lane and eight; an
 //! expensive branch is guarded by [`Mask::any`], which is a plain `if` for one lane.
 
+use super::CellTable;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 /// A lane-wise boolean: `bool` for one lane, a bit mask for several.
@@ -82,11 +83,18 @@ pub trait Real:
     fn eq(self, o: Self) -> Self::Mask;
     /// Lane-wise `if m { a } else { b }`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// The largest integer not above each lane.
+    fn floor(self) -> Self;
     fn sin_cos(self) -> (Self, Self);
     fn exp(self) -> Self;
     fn ln(self) -> Self;
     /// Whether each lane is neither infinite nor NaN.
     fn is_finite(self) -> Self::Mask;
+
+    /// The four numbers of cell `cell` of `table` in each lane (`cell` holds a cell index,
+    /// an integer below `table.len()`): the table's f64 cells for f64 lanes, its f32 cells
+    /// for f32 lanes.
+    fn gather4(table: &CellTable, cell: Self) -> [Self; 4];
 
     /// A scalar function applied lane by lane: the fallback for what does not vectorize
     /// (table lookups, the Beckmann visible-slope inversion).
@@ -120,7 +128,7 @@ pub trait Real:
 }
 
 macro_rules! scalar_real {
-    ($t:ty, $tiny:expr) => {
+    ($t:ty, $tiny:expr, $cells:ident) => {
         impl Real for $t {
             type Mask = bool;
             const LANES: usize = 1;
@@ -183,6 +191,10 @@ macro_rules! scalar_real {
                 }
             }
             #[inline(always)]
+            fn floor(self) -> Self {
+                <$t>::floor(self)
+            }
+            #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
                 <$t>::sin_cos(self)
             }
@@ -198,6 +210,10 @@ macro_rules! scalar_real {
             fn is_finite(self) -> bool {
                 <$t>::is_finite(self)
             }
+            #[inline(always)]
+            fn gather4(table: &CellTable, cell: Self) -> [Self; 4] {
+                table.$cells()[cell as usize]
+            }
             /// The native clamp, which keeps a NaN a NaN (the strict finite guard then
             /// names the model that made it).
             #[inline(always)]
@@ -208,5 +224,5 @@ macro_rules! scalar_real {
     };
 }
 
-scalar_real!(f64, 1e-300);
-scalar_real!(f32, 1e-30);
+scalar_real!(f64, 1e-300, f64_cells);
+scalar_real!(f32, 1e-30, f32_cells);

@@ -7,11 +7,11 @@
 //!
 //! IL18 eq. 16 calls the widths σ_x, σ_y; they are WMLT07's α_b (ERRATA 6).
 
-use super::{normal_from_slopes, Distribution};
+use super::{normal_from_slopes, normal_from_slopes_lanes, Distribution};
 use crate::checks::check_alpha;
 use crate::error::ParamResult;
-use crate::lanes::{LVec3, Real};
-use crate::math::special::{erf, erfc, erfinv_approx, erfinv_of_uniform};
+use crate::lanes::{CellTable, LVec3, Mask, Real};
+use crate::math::special::{erf, erfc, erfc_lanes, erfinv_approx, erfinv_of_uniform_lanes};
 use crate::math::{fmt_num, Vec2, Vec3, PI, SQRT_PI, TWO_PI};
 
 /// How G1 is evaluated.
@@ -137,14 +137,24 @@ impl Beckmann {
         self.g1_exact_lanes::<f64>(v.into())
     }
 
-    /// Exact G1 = 1/(1 + Λ) over lanes: the table lookup is per lane (it does not
-    /// vectorize), the rest lane-wise.
+    /// Exact G1 = 1/(1 + Λ) over lanes. In f64 the table lookup, per lane; in f32 lanes the
+    /// closed form G1 = 2/(1 + erf(a) + e^{−a²}/(a√π)) [WMLT07 eq. 26] with a = z/r
+    /// (r = α_v sin θ), multiplied through by a√π: G1 = 2z√π/(z√π(2 − erfc a) + r e^{−a²}),
+    /// which vectorizes ([`erfc_lanes`]), is 1 at r = 0 and 0 at z = 0, and keeps an
+    /// absolute error of a few 1e-8 (the tests measure it against the table).
     #[inline(always)]
     pub fn g1_exact_lanes<R: Real>(&self, v: LVec3<R>) -> R {
         let s2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
         let z = v.z.abs();
-        let table = g1_exact_table();
-        let g = (z / (z + s2.sqrt())).map(|y| table.eval(y));
+        let r = s2.sqrt();
+        let g = if R::DIGITS > f32::MANTISSA_DIGITS {
+            let table = g1_exact_table();
+            (z / (z + r)).map(|y| table.eval(y))
+        } else {
+            let a = z / r;
+            let zs = z * R::splat(SQRT_PI);
+            R::splat(2.0) * zs / (zs * (R::splat(2.0) - erfc_lanes(a)) + r * (-(a * a)).exp())
+        };
         R::select(s2.le(R::zero()), R::one(), g)
     }
 
@@ -186,11 +196,26 @@ impl Beckmann {
         )
     }
 
-    /// Visible normals over lanes: the slope inversion is per lane in f64 (a table and a
-    /// Halley step, which do not vectorize).
+    /// Visible normals over lanes, the one source of [`Distribution::sample_visible`]: stretch
+    /// the view to unit roughness, sample slopes ([`visible_slopes_unit_lanes`]), rotate and
+    /// unstretch [Heitz & d'Eon 2014]. The stretched view (α_x v_x, α_y v_y, v_z) need not be
+    /// normalized: the slope sampler only needs cos θ/(cos θ + sin θ) = z/(z + r).
     #[inline(always)]
     pub fn sample_visible_lanes<R: Real>(&self, v: LVec3<R>, u0: R, u1: R) -> LVec3<R> {
-        LVec3::from_fn(|i| self.sample_visible(v.lane(i), Vec2::new(u0.lane(i), u1.lane(i))))
+        let (px, py, pz) = (
+            R::splat(self.ax) * v.x,
+            R::splat(self.ay) * v.y,
+            v.z.max(R::splat(1e-12)),
+        );
+        let r = (px * px + py * py).sqrt();
+        let (sx, sy) = visible_slopes_unit_lanes(pz / (pz + r), u0, u1);
+        let tilted = r.gt(R::zero());
+        let inv = R::one() / r;
+        let cp = R::select(tilted, px * inv, R::one());
+        let sp = R::masked(tilted, py * inv);
+        let rx = cp * sx - sp * sy;
+        let ry = sp * sx + cp * sy;
+        normal_from_slopes_lanes(rx * R::splat(self.ax), ry * R::splat(self.ay))
     }
 }
 
@@ -360,12 +385,12 @@ fn visible_slope_x_iterative(y: f64, u: f64) -> f64 {
 /// t(u) = sign(u − ½) √(−ln 4u(1 − u)): the table's coordinate along u. It behaves like the
 /// Gaussian quantile in both tails (x̃ is nearly linear in it where x̃ → −∞), and is
 /// analytic through u = ½.
-#[inline]
-fn visible_slope_t(u: f64) -> f64 {
-    (-(4.0 * u * (1.0 - u)).ln())
-        .max(0.0)
-        .sqrt()
-        .copysign(u - 0.5)
+#[inline(always)]
+fn visible_slope_t<R: Real>(u: R) -> R {
+    let t = (-(R::splat(4.0) * u * (R::one() - u)).ln())
+        .max(R::zero())
+        .sqrt();
+    R::select(u.lt(R::splat(0.5)), -t, t)
 }
 
 /// The inverse of [`visible_slope_t`], and du/dt.
@@ -385,14 +410,27 @@ fn visible_slope_u(t: f64) -> (f64, f64) {
     (u, du_dt)
 }
 
-#[inline]
-fn hermite(t: f64, [p0, m0]: [f64; 2], [p1, m1]: [f64; 2]) -> f64 {
+/// Cubic Hermite interpolation on [0, 1] between (p0, m0) and (p1, m1), m the slopes per
+/// unit of t.
+#[inline(always)]
+fn hermite<R: Real>(t: R, p0: R, m0: R, p1: R, m1: R) -> R {
     let t2 = t * t;
     let t3 = t2 * t;
-    (2.0 * t3 - 3.0 * t2 + 1.0) * p0
-        + (t3 - 2.0 * t2 + t) * m0
-        + (-2.0 * t3 + 3.0 * t2) * p1
-        + (t3 - t2) * m1
+    let h01 = R::splat(3.0) * t2 - R::splat(2.0) * t3;
+    (R::one() - h01) * p0 + (t3 - R::splat(2.0) * t2 + t) * m0 + h01 * p1 + (t3 - t2) * m1
+}
+
+/// ⌊x⌋ of x ≥ 0 as a lane value, capped at `max`.
+#[inline(always)]
+fn cell_index<R: Real>(x: R, max: usize) -> R {
+    x.floor().min(R::splat(max as f64))
+}
+
+/// The Hermite interpolant of cell `cell` of `table` at t ∈ [0, 1] in the cell.
+#[inline(always)]
+fn hermite_cell<R: Real>(table: &CellTable, cell: R, t: R) -> R {
+    let [p0, m0, p1, m1] = R::gather4(table, cell);
+    hermite(t, p0, m0, p1, m1)
 }
 
 /// The inverse CDF of the visible-slope marginal x̃(y, u), tabulated once at first use:
@@ -402,10 +440,10 @@ fn hermite(t: f64, [p0, m0]: [f64; 2], [p1, m1]: [f64; 2]) -> f64 {
 /// table. The interpolated x̃ is within 1e-4 of the root (the tests measure it), and one
 /// Halley step on the exact CDF brings it to ~1e-12; see [`visible_slope_x`].
 struct VisibleSlopeTable {
-    /// (x̃, dx̃/dt · h_t), row-major: row i (y = i/NY) holds NT + 1 nodes.
-    x: Vec<[f64; 2]>,
-    /// (Z, dZ/dy · h_z) at y = k/NZ.
-    z: Vec<[f64; 2]>,
+    /// Cells of (x̃, dx̃/dt · h_t) nodes, row-major: row i (y = i/NY) holds NT cells.
+    x: CellTable,
+    /// Cells of (Z, dZ/dy · h_z) nodes at y = k/NZ.
+    z: CellTable,
     t_lo: f64,
     inv_ht: f64,
 }
@@ -423,61 +461,68 @@ impl VisibleSlopeTable {
         let (ny, nt, nz) = (Self::NY, Self::NT, Self::NZ);
         let t_lo = visible_slope_t(Self::U_MIN);
         let ht = (visible_slope_t(Self::U_MAX) - t_lo) / nt as f64;
-        let mut x = Vec::with_capacity((ny + 1) * (nt + 1));
+        let mut x = Vec::with_capacity((ny + 1) * nt);
         for i in 0..=ny {
             let y = i as f64 / ny as f64;
             let norm = visible_slope_norm(y).0;
-            for j in 0..=nt {
-                let (u, du_dt) = visible_slope_u(t_lo + j as f64 * ht);
-                let xi = visible_slope_x_iterative(y, u);
-                let dcdf = (2.0 / SQRT_PI) * (-xi * xi).exp() * (y - (1.0 - y) * xi);
-                x.push([xi, norm * du_dt / dcdf * ht]);
-            }
+            let row: Vec<[f64; 2]> = (0..=nt)
+                .map(|j| {
+                    let (u, du_dt) = visible_slope_u(t_lo + j as f64 * ht);
+                    let xi = visible_slope_x_iterative(y, u);
+                    let dcdf = (2.0 / SQRT_PI) * (-xi * xi).exp() * (y - (1.0 - y) * xi);
+                    [xi, norm * du_dt / dcdf * ht]
+                })
+                .collect();
+            x.extend(row.windows(2).map(|w| [w[0][0], w[0][1], w[1][0], w[1][1]]));
         }
-        let z = (0..=nz)
+        let z: Vec<[f64; 2]> = (0..=nz)
             .map(|k| {
                 let (v, d) = visible_slope_norm(k as f64 / nz as f64);
                 [v, d / nz as f64]
             })
             .collect();
         VisibleSlopeTable {
-            x,
-            z,
+            x: CellTable::new(x),
+            z: CellTable::from_nodes(&z),
             t_lo,
             inv_ht: 1.0 / ht,
         }
     }
 
     /// Z(y) by Hermite interpolation.
-    #[inline]
-    fn norm(&self, y: f64) -> f64 {
+    #[inline(always)]
+    fn norm<R: Real>(&self, y: R) -> R {
         let n = Self::NZ;
-        let f = (y * n as f64).clamp(0.0, n as f64);
-        let i = (f as usize).min(n - 1);
-        hermite(f - i as f64, self.z[i], self.z[i + 1])
+        let f = (y * R::splat(n as f64)).clamp(0.0, n as f64);
+        let i = cell_index(f, n - 1);
+        hermite_cell(&self.z, i, f - i)
     }
 
-    /// The interpolated x̃ at (y, t).
-    #[inline]
-    fn guess(&self, y: f64, t: f64) -> f64 {
+    /// The interpolated x̃ at (y, t): cubic Lagrange across the four rows around y, cubic
+    /// Hermite along t in each.
+    #[inline(always)]
+    fn guess<R: Real>(&self, y: R, t: R) -> R {
         let (ny, nt) = (Self::NY, Self::NT);
-        let fy = (y * ny as f64).clamp(0.0, ny as f64);
-        let i0 = ((fy as usize).max(1) - 1).min(ny - 3);
-        let a = fy - i0 as f64; // in [0, 3]: rows i0 … i0 + 3
-        let (a1, a2, a3) = (a - 1.0, a - 2.0, a - 3.0);
+        let fy = (y * R::splat(ny as f64)).clamp(0.0, ny as f64);
+        // Rows i0 … i0 + 3 with i0 = ⌊fy⌋ − 1 kept in [0, ny − 3].
+        let i0 = (fy.floor() - R::one()).clamp(0.0, (ny - 3) as f64);
+        let a = fy - i0; // in [0, 3]
+        let (a1, a2, a3) = (a - R::one(), a - R::splat(2.0), a - R::splat(3.0));
+        let sixth = R::splat(1.0 / 6.0);
+        let half = R::splat(0.5);
         let w = [
-            -a1 * a2 * a3 / 6.0,
-            a * a2 * a3 / 2.0,
-            -a * a1 * a3 / 2.0,
-            a * a1 * a2 / 6.0,
+            -a1 * a2 * a3 * sixth,
+            a * a2 * a3 * half,
+            -a * a1 * a3 * half,
+            a * a1 * a2 * sixth,
         ];
-        let ft = ((t - self.t_lo) * self.inv_ht).clamp(0.0, nt as f64);
-        let j = (ft as usize).min(nt - 1);
-        let b = ft - j as f64;
-        let mut x = 0.0;
-        for (k, wk) in w.iter().enumerate() {
-            let n = (i0 + k) * (nt + 1) + j;
-            x += wk * hermite(b, self.x[n], self.x[n + 1]);
+        let ft = ((t - R::splat(self.t_lo)) * R::splat(self.inv_ht)).clamp(0.0, nt as f64);
+        let j = cell_index(ft, nt - 1);
+        let b = ft - j;
+        let first = i0 * R::splat(nt as f64) + j;
+        let mut x = R::zero();
+        for (k, wk) in w.into_iter().enumerate() {
+            x = x + wk * hermite_cell(&self.x, first + R::splat((k * nt) as f64), b);
         }
         x
     }
@@ -488,43 +533,49 @@ fn visible_slope_table() -> &'static VisibleSlopeTable {
     TABLE.get_or_init(VisibleSlopeTable::build)
 }
 
-/// x̃ for u in [1e-12, 1 − 1e-12]: the tabulated inverse CDF and ONE Halley step on the exact
-/// CDF (one erfc and one exp), or, for u above the table's 1 − 1e-4, the iteration.
-#[inline]
-fn visible_slope_x(y: f64, u: f64) -> f64 {
-    if u > VisibleSlopeTable::U_MAX {
-        return visible_slope_x_iterative(y, u);
-    }
+/// x̃ for u in [1e-12, 1 − 1e-12] over lanes: the tabulated inverse CDF and ONE Halley step
+/// on the exact CDF (one erfc and one exp, [`erfc_lanes`]), or, for lanes with u above the
+/// table's 1 − 1e-4, the iteration (in f64, lane by lane).
+#[inline(always)]
+fn visible_slope_x<R: Real>(y: R, u: R) -> R {
     let table = visible_slope_table();
-    let (c, s) = (y, 1.0 - y);
-    let mut x = table.guess(y, visible_slope_t(u));
-    if s * x > c {
-        x = c / s; // never past the horizon slope cot θ
-    }
-    let ex = (-x * x).exp();
-    let f = c * erfc(-x) + s * ex / SQRT_PI - u * table.norm(y);
-    let d1 = (2.0 / SQRT_PI) * ex * (c - s * x);
-    let d2 = (2.0 / SQRT_PI) * ex * (-2.0 * x * (c - s * x) - s);
-    let den = 2.0 * d1 * d1 - f * d2;
-    if den > 0.0 {
-        x -= 2.0 * f * d1 / den;
-    }
-    if s * x > c {
-        c / s
+    let (c, s) = (y, R::one() - y);
+    let horizon = c / s; // x̃ never passes the horizon slope cot θ
+    let x = table.guess(y, visible_slope_t(u));
+    let x = R::select((s * x).gt(c), horizon, x);
+    let ex = (-(x * x)).exp();
+    let two_over_sqrt_pi = R::splat(2.0 / SQRT_PI);
+    let f = c * erfc_lanes(-x) + s * ex * R::splat(1.0 / SQRT_PI) - u * table.norm(y);
+    let d1 = two_over_sqrt_pi * ex * (c - s * x);
+    let d2 = two_over_sqrt_pi * ex * (R::splat(-2.0) * x * (c - s * x) - s);
+    let den = R::splat(2.0) * d1 * d1 - f * d2;
+    let x = R::select(den.gt(R::zero()), x - R::splat(2.0) * f * d1 / den, x);
+    let x = R::select((s * x).gt(c), horizon, x);
+    let upper = u.gt(R::splat(VisibleSlopeTable::U_MAX));
+    if upper.any() {
+        let iterated = R::from_fn(|l| visible_slope_x_iterative(y.lane(l), u.lane(l)));
+        R::select(upper, iterated, x)
     } else {
         x
     }
 }
 
 /// Samples the slopes (x̃, ỹ) of visible normals of the unit-width isotropic Beckmann
-/// distribution seen at y = cos θ/(cos θ + sin θ) [Heitz & d'Eon 2014]: x̃ from the
-/// tabulated inverse CDF refined by one Halley step ([`visible_slope_x`]), ỹ the Gaussian
-/// quantile of u.y (Giles' double-precision erfinv, no erf evaluation).
-#[inline]
-fn sample_visible_slopes_unit(y: f64, u: Vec2) -> (f64, f64) {
-    let ux = u.x.clamp(1e-12, 1.0 - 1e-12);
-    let uy = u.y.clamp(1e-12, 1.0 - 1e-12);
-    (visible_slope_x(y, ux), erfinv_of_uniform(uy))
+/// distribution seen at y = cos θ/(cos θ + sin θ) [Heitz & d'Eon 2014], over lanes: x̃ from
+/// the tabulated inverse CDF refined by one Halley step ([`visible_slope_x`]), ỹ the
+/// Gaussian quantile of u₁ ([`erfinv_of_uniform_lanes`], no erf evaluation). The uniform
+/// numbers are kept inside the lane type's open interval (1e-12 … 1 − 1e-12 in f64,
+/// 1 − 2⁻²⁴ in f32, where 1 − 1e-12 rounds to 1).
+#[inline(always)]
+fn visible_slopes_unit_lanes<R: Real>(y: R, u0: R, u1: R) -> (R, R) {
+    let hi = if R::DIGITS > f32::MANTISSA_DIGITS {
+        1.0 - 1e-12
+    } else {
+        1.0 - f32::EPSILON as f64 / 2.0
+    };
+    let ux = u0.clamp(1e-12, hi);
+    let uy = u1.clamp(1e-12, hi);
+    (visible_slope_x(y, ux), erfinv_of_uniform_lanes(uy))
 }
 
 impl Distribution for Beckmann {
@@ -567,22 +618,9 @@ impl Distribution for Beckmann {
         true
     }
 
-    /// Visible normals: stretch the view to unit roughness, sample slopes, rotate and
-    /// unstretch [Heitz & d'Eon 2014]. The stretched view (α_x v_x, α_y v_y, v_z) need not
-    /// be normalized: the slope sampler only needs cos θ/(cos θ + sin θ) = z/(z + r).
+    /// Visible normals [Heitz & d'Eon 2014]: [`Beckmann::sample_visible_lanes`] in f64.
     fn sample_visible(&self, v: Vec3, u: Vec2) -> Vec3 {
-        let (px, py, pz) = (self.ax * v.x, self.ay * v.y, v.z.max(1e-12));
-        let r = (px * px + py * py).sqrt();
-        let (sx, sy) = sample_visible_slopes_unit(pz / (pz + r), u);
-        let (cp, sp) = if r > 0.0 {
-            let inv = 1.0 / r;
-            (px * inv, py * inv)
-        } else {
-            (1.0, 0.0)
-        };
-        let rx = cp * sx - sp * sy;
-        let ry = sp * sx + cp * sy;
-        normal_from_slopes(rx * self.ax, ry * self.ay)
+        self.sample_visible_lanes::<f64>(v.into(), u.x, u.y).into()
     }
 
     /// D_v(m) with the exact Λ, whatever G1 form the model evaluates.
@@ -676,6 +714,57 @@ mod tests {
         assert!(worst < 1e-11, "{worst:e} at {at:?}");
     }
 
+    /// The renderer's f32 lanes: x̃ (table, one Halley step in f32) against the f64
+    /// iteration at the same (f32) inputs, and G1 by the f32 closed form against the table.
+    #[test]
+    fn f32_lanes_sample_slopes_and_evaluate_g1_to_f32_precision() {
+        use crate::lanes::F32x8;
+        let us: Vec<f64> = u_grid().into_iter().map(|u| u as f32 as f64).collect();
+        let (mut worst, mut worst_x, mut at) = (0.0f64, 0.0f64, (0.0, 0.0));
+        for i in 0..=200 {
+            let y = (i as f64 / 200.0 + if i < 200 { 1.3e-3 } else { 0.0 }) as f32 as f64;
+            for &u in &us {
+                let (x, _) =
+                    visible_slopes_unit_lanes(F32x8::splat(y), F32x8::splat(u), F32x8::splat(0.5));
+                let x = x.lane(0);
+                let u = u.clamp(1e-12, 1.0 - f32::EPSILON as f64 / 2.0);
+                let exact = visible_slope_x_iterative(y, u);
+                assert!(
+                    x.is_finite() && x * (1.0 - y) <= y * (1.0 + 1e-6),
+                    "y={y} u={u}: {x}"
+                );
+                // Backward error: the u whose exact inverse x̃ is, against the given u —
+                // absolute, and relative in the lower tail (f32's own spacing of u is 6e-8
+                // near 1, where x̃ is most sensitive to u).
+                let cdf = visible_slope_cdf(y, x) / visible_slope_norm(y).0;
+                let e = (cdf - u).abs() / u.clamp(1e-12, 0.5) * 0.5;
+                worst_x = worst_x.max((x - exact).abs() / (1.0 + exact.abs()));
+                if e > worst {
+                    (worst, at) = (e, (y, u));
+                }
+            }
+        }
+        let b = Beckmann::new(0.3, 0.7).unwrap();
+        let mut worst_g1: f64 = 0.0;
+        for k in 0..=20_000 {
+            let theta = k as f64 / 20_000.0 * 0.5 * PI;
+            let phi = k as f64 * 0.618_034 * TWO_PI;
+            let v = crate::math::spherical_direction(theta, phi);
+            let lanes = LVec3::new(F32x8::splat(v.x), F32x8::splat(v.y), F32x8::splat(v.z));
+            let g = b.g1_exact_lanes(lanes).lane(0);
+            let vf = Vec3::new(v.x as f32 as f64, v.y as f32 as f64, v.z as f32 as f64);
+            worst_g1 = worst_g1.max((g - b.g1_exact_fast(vf)).abs());
+        }
+        println!(
+            "f32 lanes: x̃ within {worst_x:e} of the iteration (relative to 1 + |x̃|); \
+             backward error in u {worst:e} (relative below ½, at y, u = {at:?}); \
+             G1 within {worst_g1:e}"
+        );
+        assert!(worst < 1e-5, "{worst:e}");
+        assert!(worst_x < 2e-4, "{worst_x:e}");
+        assert!(worst_g1 < 1e-6, "{worst_g1:e}");
+    }
+
     #[test]
     fn visible_slope_norm_table_matches_the_closed_form() {
         let t = visible_slope_table();
@@ -706,7 +795,7 @@ mod tests {
         for &y in &ys {
             for &ux in &us {
                 for &uy in &us {
-                    let (sx, sy) = sample_visible_slopes_unit(y, Vec2::new(ux, uy));
+                    let (sx, sy) = visible_slopes_unit_lanes(y, ux, uy);
                     assert!(sx.is_finite() && sy.is_finite(), "y={y} u=({ux}, {uy})");
                     // Never past the horizon slope cot θ = y/(1 − y).
                     assert!(sx * (1.0 - y) <= y, "y={y} u={ux}: x̃ = {sx}");

@@ -22,6 +22,7 @@ pub use ggx::Ggx;
 pub use masking::Masking;
 pub use phong::{Phong, PhongG1};
 
+use crate::lanes::{LVec3, Mask, Real};
 use crate::math::{Vec2, Vec3};
 
 /// Roughness below which a model treats its surface as perfectly smooth (delta lobes).
@@ -92,13 +93,25 @@ pub(crate) fn visible_density(lambda_v: f64, v: Vec3, m: Vec3, d: f64) -> f64 {
 /// Microfacet normal from slopes (x̃, ỹ): m ∝ (−x̃, −ỹ, 1).
 #[inline]
 pub(crate) fn normal_from_slopes(sx: f64, sy: f64) -> Vec3 {
-    let inv = 1.0 / (1.0 + sx * sx + sy * sy).sqrt();
-    if !inv.is_finite() || inv == 0.0 {
-        // Slopes so large the normal is numerically in the plane: keep it just above it.
-        let l = (sx * sx + sy * sy).sqrt();
-        return Vec3::new(-sx / l, -sy / l, 1e-300).normalize();
+    normal_from_slopes_lanes(sx, sy).into()
+}
+
+/// [`normal_from_slopes`] over lanes.
+#[inline(always)]
+pub(crate) fn normal_from_slopes_lanes<R: Real>(sx: R, sy: R) -> LVec3<R> {
+    let q = R::one() + sx * sx + sy * sy;
+    let inv = R::one() / q.sqrt();
+    let m = LVec3::new(-sx * inv, -sy * inv, inv);
+    // 1/√q is 0 or not finite exactly where q is +∞ or NaN (q ≥ 1 otherwise): one compare,
+    // which vectorizes where `is_finite` on the result would not.
+    let flat = !q.lt(R::splat(f64::INFINITY));
+    if flat.none() {
+        return m;
     }
-    Vec3::new(-sx * inv, -sy * inv, inv)
+    // Slopes so large the normal is numerically in the plane: keep it just above it.
+    let l = (sx * sx + sy * sy).sqrt();
+    let edge = LVec3::new(-sx / l, -sy / l, R::splat(R::TINY)).normalize();
+    LVec3::select(flat, edge, m)
 }
 
 /// Any distribution of the core, dispatched statically (models hold this by value).
