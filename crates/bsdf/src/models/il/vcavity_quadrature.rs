@@ -89,7 +89,7 @@
 
 use super::vcavity::Orders;
 use crate::fresnel::fresnel_dielectric;
-use crate::math::adaptive_quadrature::{integrate_2d, InnerRange, Tolerance};
+use crate::math::adaptive_quadrature::{integrate_2d, ErrorEstimate, InnerRange, Tolerance};
 use crate::math::quadrature::GaussLegendre;
 use crate::math::spectrum::{Spectrum, CHANNELS};
 use crate::math::{Vec3, PI};
@@ -800,24 +800,21 @@ impl VCavityQuadrature {
         op
     }
 
-    /// p_ms(o | i, m) for groove (θ, φ) and the channels `chans`, written to `out`.
-    fn groove_density(
-        &self,
-        op: &GrooveOperator,
-        i: Vec3,
-        o: Vec3,
-        phi: f64,
-        scratch: &mut Scratch,
-        out: &mut [f64; CHANNELS],
-    ) {
+    /// Traces the beams from i and o into groove `w` at azimuth φ (into `scratch`).
+    fn trace_both(&self, w: &Wedge, i: Vec3, o: Vec3, phi: f64, scratch: &mut Scratch) {
         let (sp, cp) = phi.sin_cos();
         let di = (-(i.x * cp + i.y * sp), -i.z);
         let dout = (-(o.x * cp + o.y * sp), -o.z);
-        let w = &op.wedge;
         trace_beam(w, di, self.ni, &mut scratch.ih, &mut scratch.ie);
         trace_beam(w, dout, self.ni, &mut scratch.oh, &mut scratch.oe);
+    }
+
+    /// The direct part of p_ms(o | i, m), ⟨E_o, J⁰⟩/c_b: one body event, at a point where
+    /// an i footprint and an o footprint overlap (beams already traced). It needs no groove
+    /// operator, and it alone has the kinks where footprint ends cross, so it is integrated
+    /// on its own (see [`Self::eval`]).
+    fn direct_density(&self, scratch: &Scratch) -> f64 {
         let second = self.orders == Orders::Second;
-        // Direct pairs: body at an i footprint, out along an o chain.
         let mut direct = 0.0;
         for a in &scratch.ih {
             let wa = a.u1 - a.u0;
@@ -844,8 +841,20 @@ impl VCavityQuadrature {
                 }
             }
         }
-        // Inter-reflections: Σ over (E_o interval, J⁰ interval) of value × density × the
-        // resolvent's integral over the rectangle (cumulative table at its corners).
+        direct
+    }
+
+    /// The inter-reflection part of p_ms(o | i, m), ⟨E_o, 𝒜J⁰⟩, for groove operator `op`
+    /// (beams already traced), per channel into `out`.
+    fn galerkin_density(
+        &self,
+        op: &GrooveOperator,
+        scratch: &mut Scratch,
+        out: &mut [f64; CHANNELS],
+    ) {
+        let second = self.orders == Orders::Second;
+        // Σ over (E_o interval, J⁰ interval) of value × density × the resolvent's integral
+        // over the rectangle (cumulative table at its corners).
         let bounds = &op.bounds;
         let ends = |h: &Hit| (Abscissa::new(bounds, h.u0), Abscissa::new(bounds, h.u1));
         scratch.src.clear();
@@ -882,12 +891,19 @@ impl VCavityQuadrature {
                     gal += ev * jd * rect;
                 }
             }
-            out[ch] = cb * (direct + gal);
+            out[ch] = cb * gal;
         }
     }
 
     /// The multiple-scattering BRDF f_ms(i, o) (orders ≥ 2, or exactly 2) and its estimated
     /// error, for upper-hemisphere i and o.
+    ///
+    /// p_ms = c_b (⟨E_o, J⁰⟩ + ⟨E_o, 𝒜J⁰⟩) is integrated as two groove-orientation
+    /// integrals [IL18 eq. 23]: the direct part (one body event; grey, no operator, cheap,
+    /// but kinked wherever footprint ends cross, so its rule subdivides a lot) and the
+    /// inter-reflections (smooth in the footprint ends through the C¹ cumulative tables,
+    /// dear per evaluation, few evaluations). Both are positive, so each to the relative
+    /// tolerance puts their sum within it; the reported error is the sum of their estimates.
     pub fn eval(&self, i: Vec3, o: Vec3) -> MsValue {
         if !(i.z > 0.0 && o.z > 0.0) {
             return MsValue {
@@ -903,59 +919,62 @@ impl VCavityQuadrature {
         let channels = if self.grey() { 1 } else { CHANNELS };
         // Fixed first segments (θ nodes then repeat across pairs and hit the cache).
         let breaks = [0.125 * PI, 0.25 * PI, 0.375 * PI];
+        let tol = Tolerance {
+            rel: self.tolerance,
+            abs: 1e-12,
+            max_segments: 200,
+            estimate: ErrorEstimate::Embedded,
+        };
+        let azimuths = |theta| InnerRange {
+            lo: 0.0,
+            hi: PI,
+            breaks: azimuth_breaks(theta, i, o),
+        };
+        let weight = |theta: f64, phi: f64| {
+            let (st, ct) = theta.sin_cos();
+            let m = Vec3::new(st * phi.cos(), st * phi.sin(), ct);
+            2.0 * self.ndf.d(m) * ct * st
+        };
         let mut scratch = Scratch::default();
-        let mut evaluations = 0;
-        let mut converged = true;
         let dirac = self.specular_chains(i, o, &mut scratch);
+        let direct = integrate_2d(0.0, self.theta_max, &breaks, tol, azimuths, |theta, phi| {
+            let w = weight(theta, phi);
+            if !(w > 0.0) {
+                return 0.0;
+            }
+            self.trace_both(&Wedge::new(theta), i, o, phi, &mut scratch);
+            w * self.direct_density(&scratch)
+        });
+        let mut evaluations = direct.evaluations;
+        let mut converged = direct.converged;
         for ch in 0..channels {
             let mut current: Option<(u64, Arc<GrooveOperator>)> = None;
-            let mut run = |tol: Tolerance, scratch: &mut Scratch| {
-                integrate_2d(
-                    0.0,
-                    self.theta_max,
-                    &breaks,
-                    tol,
-                    |theta| InnerRange {
-                        lo: 0.0,
-                        hi: PI,
-                        breaks: azimuth_breaks(theta, i, o),
-                    },
-                    |theta, phi| {
-                        let key = theta.to_bits();
-                        let op = match &current {
-                            Some((k, op)) if *k == key => op.clone(),
-                            _ => {
-                                let op = self.operator(theta);
-                                current = Some((key, op.clone()));
-                                op
-                            }
-                        };
-                        let (st, ct) = theta.sin_cos();
-                        let m = Vec3::new(st * phi.cos(), st * phi.sin(), ct);
-                        let w = 2.0 * self.ndf.d(m) * ct * st;
-                        if !(w > 0.0) {
-                            return 0.0;
-                        }
-                        let mut out = [0.0; CHANNELS];
-                        self.groove_density(&op, i, o, phi, scratch, &mut out);
-                        w * out[ch]
-                    },
-                )
-            };
-            let q = run(
-                Tolerance {
-                    rel: self.tolerance,
-                    abs: 1e-12,
-                    max_segments: 200,
-                },
-                &mut scratch,
-            );
+            let q = integrate_2d(0.0, self.theta_max, &breaks, tol, azimuths, |theta, phi| {
+                let key = theta.to_bits();
+                let op = match &current {
+                    Some((k, op)) if *k == key => op.clone(),
+                    _ => {
+                        let op = self.operator(theta);
+                        current = Some((key, op.clone()));
+                        op
+                    }
+                };
+                let w = weight(theta, phi);
+                if !(w > 0.0) {
+                    return 0.0;
+                }
+                self.trace_both(&op.wedge, i, o, phi, &mut scratch);
+                let mut out = [0.0; CHANNELS];
+                self.galerkin_density(&op, &mut scratch, &mut out);
+                w * out[ch]
+            });
             evaluations += q.evaluations;
             converged &= q.converged;
             for c in 0..CHANNELS {
                 if channels == 1 || c == ch {
-                    value.0[c] = (q.value + dirac) / o.z;
-                    error.0[c] = q.error / o.z;
+                    let cb = self.body_factor.0[c];
+                    value.0[c] = (cb * direct.value + q.value + dirac) / o.z;
+                    error.0[c] = (cb * direct.error + q.error) / o.z;
                 }
             }
         }
