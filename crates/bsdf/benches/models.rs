@@ -221,8 +221,10 @@ fn albedo_tables(c: &mut Criterion) {
 
 /// IL_∞ eval with the deterministic V-cavity multiple scattering (issue 18: the target is
 /// 200 direction pairs per second at tolerance 1e-4), per direction pair, with the groove
-/// operators of the quadrature nodes already cached (the steady state of a sweep); the walk
-/// at 100,000 estimates per pair is the alternative (about 0.26 s a pair).
+/// operators of the quadrature nodes already cached (the steady state of a sweep: the θ_m
+/// nodes come from one dyadic tree, so a sweep's pairs share them); the walk at 100,000
+/// estimates per pair is the alternative (about 0.26 s a pair). Beckmann α = 1.2 (deep
+/// grooves, long chains) is the slow end of the range. Measured figures: docs/performance.md.
 fn il_multiple(c: &mut Criterion) {
     let mut g = c.benchmark_group("il-multiple-quadrature");
     g.sample_size(10);
@@ -235,16 +237,16 @@ fn il_multiple(c: &mut Criterion) {
     .iter()
     .map(|&(to, ti, pi)| (spherical_direction(to, 0.0), spherical_direction(ti, pi)))
     .collect();
-    for tol in ["1e-4", "1e-3"] {
+    for (alpha, tol) in [("0.5", "1e-4"), ("0.5", "1e-3"), ("1.2", "1e-4")] {
         let m = build_material(
             &parse_inline_table(&format!(
-                "{{type = \"il\", kd = 0.8, ni = 1.5, distribution = \"beckmann\", alpha = 0.5, scattering = \"multiple\", multiple_evaluation = \"quadrature\", tolerance = {tol}}}"
+                "{{type = \"il\", kd = 0.8, ni = 1.5, distribution = \"beckmann\", alpha = {alpha}, scattering = \"multiple\", multiple_evaluation = \"quadrature\", tolerance = {tol}}}"
             ))
             .unwrap(),
         )
         .unwrap();
         g.throughput(Throughput::Elements(pairs.len() as u64));
-        g.bench_function(format!("beckmann-0.5-tolerance-{tol}"), |b| {
+        g.bench_function(format!("beckmann-{alpha}-tolerance-{tol}"), |b| {
             let mut rng = Pcg32::new(1, 1);
             b.iter(|| {
                 for (wo, wi) in &pairs {
