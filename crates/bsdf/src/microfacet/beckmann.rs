@@ -7,7 +7,7 @@
 //!
 //! IL18 eq. 16 calls the widths σ_x, σ_y; they are WMLT07's α_b (ERRATA 6).
 
-use super::{normal_from_slopes, normal_from_slopes_lanes, Distribution};
+use super::{normal_from_slopes_lanes, Distribution};
 use crate::checks::check_alpha;
 use crate::error::ParamResult;
 use crate::lanes::{CellTable, LVec3, Mask, Real};
@@ -194,6 +194,16 @@ impl Beckmann {
             R::zero(),
             d,
         )
+    }
+
+    /// D(m)|m·n| sampling over lanes, the one source of [`Distribution::sample_normal`]:
+    /// slopes r(cos 2πu₁, sin 2πu₁), r = √(−ln(1 − u₀)), stretched by (α_x, α_y)
+    /// [IL18 eqs. 29–30 in slope space].
+    #[inline(always)]
+    pub fn sample_normal_lanes<R: Real>(&self, u0: R, u1: R) -> LVec3<R> {
+        let r = (-(R::one() - u0).ln()).sqrt();
+        let (s, c) = (R::splat(TWO_PI) * u1).sin_cos();
+        normal_from_slopes_lanes(r * c * R::splat(self.ax), r * s * R::splat(self.ay))
     }
 
     /// Visible normals over lanes, the one source of [`Distribution::sample_visible`]: stretch
@@ -603,9 +613,7 @@ impl Distribution for Beckmann {
     /// in slope space, which avoids the quadrant bookkeeping of the arctan in eq. 29.
     #[inline]
     fn sample_normal(&self, u: Vec2) -> Vec3 {
-        let r = (-(1.0 - u.x).ln()).sqrt();
-        let (s, c) = (TWO_PI * u.y).sin_cos();
-        normal_from_slopes(r * c * self.ax, r * s * self.ay)
+        self.sample_normal_lanes::<f64>(u.x, u.y).into()
     }
 
     /// p(m) = D(m) |m·n|  [WMLT07 eq. 24].

@@ -9,7 +9,7 @@
 //! eqs. 29 and 31, and the normalization test proves it. Eq. 31 uses ξ1 twice (ERRATA 3):
 //! θ_m uses the second, independent number.
 
-use super::{normal_from_slopes, visible_density, Distribution};
+use super::{normal_from_slopes_lanes, visible_density, Distribution};
 use crate::checks::check_alpha;
 use crate::error::ParamResult;
 use crate::lanes::{LVec3, Real};
@@ -112,6 +112,14 @@ impl Ggx {
         R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g)
     }
 
+    /// D(m)|m·n| sampling over lanes, the one source of [`Distribution::sample_normal`].
+    #[inline(always)]
+    pub fn sample_normal_lanes<R: Real>(&self, u0: R, u1: R) -> LVec3<R> {
+        let r = (u0 / (R::one() - u0)).sqrt();
+        let (s, c) = (R::splat(TWO_PI) * u1).sin_cos();
+        normal_from_slopes_lanes(r * c * R::splat(self.ax), r * s * R::splat(self.ay))
+    }
+
     /// Visible normals of the view v (z ≥ 0) from (u0, u1) [Heitz 2018, "Sampling the GGX
     /// Distribution of Visible Normals", listing 1]: stretch the view to unit roughness,
     /// sample the projected disk warped toward the view, unstretch.
@@ -163,9 +171,7 @@ impl Distribution for Ggx {
     /// eqs. 35–36 when isotropic.
     #[inline]
     fn sample_normal(&self, u: Vec2) -> Vec3 {
-        let r = (u.x / (1.0 - u.x)).sqrt();
-        let (s, c) = (TWO_PI * u.y).sin_cos();
-        normal_from_slopes(r * c * self.ax, r * s * self.ay)
+        self.sample_normal_lanes::<f64>(u.x, u.y).into()
     }
 
     #[inline]

@@ -1,10 +1,12 @@
 //! The models that vectorize, over lanes: Lambert, the rough conductor and the rough
-//! dielectric (WMLT07) with GGX or Beckmann, separable Smith masking and visible-normal
-//! sampling — the materials of the renderer's packet kernel. Each lane holds one shading
+//! dielectric (WMLT07) and rough interfaced Lambertian (IL18, single scattering, stochastic
+//! body) with GGX or Beckmann, separable Smith masking and visible-normal sampling — the
+//! materials of the renderer's packet kernel. Each lane holds one shading
 //! point's pair of directions in its local frame (radiance transport: `wo` toward the
 //! camera, `wi` toward the light). Built from a material recipe by
 //! `MaterialRecipe::lane_model`; any other recipe (smooth interfaces, multiple scattering,
-//! compensation, other distributions or maskings, IL, KSK01, glints) runs through its f64
+//! compensation, other distributions or maskings, IL's other body evaluations and multiple
+//! scattering, KSK01, glints) runs through its f64
 //! [`Bsdf`](crate::Bsdf) lane by lane in the kernel.
 //!
 //! Two things differ from the f64 models on purpose, as Mitsuba's `roughdielectric` does:
@@ -93,6 +95,15 @@ impl LaneNdf {
         }
     }
 
+    /// m drawn from D(m)|m·n| [WMLT07 eqs. 28–29, 35–36; IL18 eqs. 29–31].
+    #[inline(always)]
+    fn sample_normal<R: Real>(&self, u0: R, u1: R) -> LVec3<R> {
+        match self {
+            LaneNdf::Ggx(g) => g.sample_normal_lanes(u0, u1),
+            LaneNdf::Beckmann(b) => b.sample_normal_lanes(u0, u1),
+        }
+    }
+
     /// G(i, o, m) with separable Smith masking [WMLT07 eq. 23].
     #[inline(always)]
     fn g<R: Real>(&self, i: LVec3<R>, o: LVec3<R>, m: LVec3<R>) -> R {
@@ -136,6 +147,14 @@ impl LaneFresnel {
     }
 }
 
+/// Where a stochastic lane model takes its further random numbers: the draws its f64 model
+/// makes from the sample's free stream after the sampler's dimensions, one pair for each
+/// lane of `lanes` (and none for the others, so that every lane's stream advances as the
+/// f64 model's would).
+pub trait LaneRandom<R: Real> {
+    fn next_2d(&mut self, lanes: R::Mask) -> (R, R);
+}
+
 /// A model written over lanes.
 #[derive(Clone, Debug)]
 pub enum LaneBsdf {
@@ -154,6 +173,17 @@ pub enum LaneBsdf {
         eta: f64,
         reflect_tint: [f64; 3],
         transmit_tint: [f64; 3],
+    },
+    /// Two-sided rough interfaced Lambertian, single scattering, with the body integral
+    /// estimated by one microfacet per evaluation [IL18 eqs. 4, 13 and 28]
+    /// (`models::il::InterfacedLambertian` with `evaluation = "stochastic"`).
+    Il {
+        ndf: LaneNdf,
+        ni: f64,
+        /// K_d/(π n_i² (1 − K_d r_i)) per channel.
+        body: [f64; 3],
+        /// The probability of sampling the specular lobe [IL18 §4.1].
+        specular_probability: f64,
     },
 }
 
@@ -206,19 +236,37 @@ impl LaneBsdf {
             LaneBsdf::Dielectric { .. } => {
                 LobeFlags::GLOSSY_REFLECTION | LobeFlags::GLOSSY_TRANSMISSION
             }
+            LaneBsdf::Il { .. } => LobeFlags::GLOSSY_REFLECTION | LobeFlags::DIFFUSE_REFLECTION,
+        }
+    }
+
+    /// The lane form of a rough, single-scattering, stochastic interfaced Lambertian model
+    /// whose lobe has the lane distribution `ndf`.
+    pub fn il(ndf: LaneNdf, il: &crate::models::il::InterfacedLambertian) -> LaneBsdf {
+        LaneBsdf::Il {
+            ndf,
+            ni: il.ni(),
+            body: il.body_factor().0.map(|k| k * INV_PI),
+            specular_probability: il.specular_probability(),
         }
     }
 
     /// Whether [`sample`](Self::sample) reads its lobe number `u_lobe` (the dielectric's
-    /// choice between reflection and refraction); the one-lobe models ignore it, and the
-    /// renderer leaves that dimension undrawn.
+    /// choice between reflection and refraction, IL's between its two lobes); the one-lobe
+    /// models ignore it, and the renderer leaves that dimension undrawn.
     pub fn reads_lobe_number(&self) -> bool {
-        matches!(self, LaneBsdf::Dielectric { .. })
+        matches!(self, LaneBsdf::Dielectric { .. } | LaneBsdf::Il { .. })
     }
 
-    /// The value f(wo, wi) (no cosine) and the density of sampling wi from wo.
+    /// The value f(wo, wi) (no cosine) and the density of sampling wi from wo; a stochastic
+    /// model draws its further numbers from `rng`.
     #[inline(always)]
-    pub fn eval_pdf<R: Real>(&self, wo: LVec3<R>, wi: LVec3<R>) -> ([R; 3], R) {
+    pub fn eval_pdf<R: Real>(
+        &self,
+        wo: LVec3<R>,
+        wi: LVec3<R>,
+        rng: &mut impl LaneRandom<R>,
+    ) -> ([R; 3], R) {
         match self {
             LaneBsdf::Lambert { reflectance } => {
                 let same = (wo.z * wi.z).gt(R::zero());
@@ -245,6 +293,21 @@ impl LaneBsdf {
                 reflect_tint,
                 transmit_tint,
             } => Self::dielectric_eval_pdf(ndf, *eta, reflect_tint, transmit_tint, wo, wi),
+            LaneBsdf::Il {
+                ndf,
+                ni,
+                body,
+                specular_probability,
+            } => {
+                let s = upper(wo);
+                let (o, i) = (mirror(wo, s), mirror(wi, s));
+                let same = (wo.z * wi.z).gt(R::zero());
+                let (spec, pdf) = Self::il_specular(ndf, *ni, *specular_probability, o, i);
+                let (u0, u1) = rng.next_2d(same);
+                let b = Self::il_body(ndf, *ni, o, i, u0, u1);
+                let f = std::array::from_fn(|c| R::masked(same, spec + R::splat(body[c]) * b));
+                (f, R::masked(same, pdf))
+            }
         }
     }
 
@@ -298,10 +361,60 @@ impl LaneBsdf {
         (v, R::masked(ok, pdf))
     }
 
-    /// Samples wi from wo with the lobe number `u_lobe` and the direction numbers
-    /// (`u0`, `u1`) — the numbers the f64 model takes from its source in that order.
+    /// IL's specular value and its density for a pair in the upper hemisphere (0 where
+    /// either is not above it): F(o·h) D G/(4 i_z o_z) [IL18 eq. 4], and the mixture of the
+    /// visible-normal reflection and the cosine lobe [IL18 §4.1].
     #[inline(always)]
-    pub fn sample<R: Real>(&self, wo: LVec3<R>, u_lobe: R, u0: R, u1: R) -> LaneSample<R> {
+    fn il_specular<R: Real>(
+        ndf: &LaneNdf,
+        ni: f64,
+        specular_probability: f64,
+        o: LVec3<R>,
+        i: LVec3<R>,
+    ) -> (R, R) {
+        let zero = R::zero();
+        let above = o.z.gt(zero) & i.z.gt(zero);
+        let h = (o + i).normalize();
+        let cos_oh = o.dot(h);
+        let lobe = above & h.z.gt(zero) & cos_oh.gt(zero);
+        let d = ndf.d(h);
+        let spec = d * ndf.g(i, o, h) / (R::splat(4.0) * o.z * i.z)
+            * fresnel_dielectric_lanes(cos_oh, R::splat(ni));
+        let spec = R::select(lobe & spec.gt(zero), spec, zero);
+        let spec_pdf = ndf.pdf_visible(o, h, d) / (R::splat(4.0) * cos_oh);
+        let spec_pdf = R::select(lobe & spec_pdf.is_finite(), spec_pdf, zero);
+        let ps = R::splat(specular_probability);
+        let pdf = ps * spec_pdf + (R::one() - ps) * R::masked(above, i.z * R::splat(INV_PI));
+        (spec, pdf)
+    }
+
+    /// IL's body integral for a pair in the upper hemisphere estimated with one microfacet m
+    /// drawn from D(m) m_z by (u0, u1): T(i·m) T(o·m) G(i, o, m) (i·m)(o·m)/(i_z o_z m_z)
+    /// [IL18 eqs. 13 and 28; D over its density D m_z], 0 where m faces away from either.
+    #[inline(always)]
+    fn il_body<R: Real>(ndf: &LaneNdf, ni: f64, o: LVec3<R>, i: LVec3<R>, u0: R, u1: R) -> R {
+        let zero = R::zero();
+        let m = ndf.sample_normal(u0, u1);
+        let (im, om) = (i.dot(m), o.dot(m));
+        let eta = R::splat(ni);
+        let t = |c: R| R::one() - fresnel_dielectric_lanes(c, eta);
+        let b = t(im) * t(om) * ndf.g(i, o, m) * im * om / (i.z * o.z * m.z);
+        let facing = o.z.gt(zero) & i.z.gt(zero) & im.gt(zero) & om.gt(zero) & m.z.gt(zero);
+        R::select(facing, b, zero)
+    }
+
+    /// Samples wi from wo with the lobe number `u_lobe` and the direction numbers
+    /// (`u0`, `u1`) — the numbers the f64 model takes from its source in that order — and,
+    /// for a stochastic model, further numbers from `rng`.
+    #[inline(always)]
+    pub fn sample<R: Real>(
+        &self,
+        wo: LVec3<R>,
+        u_lobe: R,
+        u0: R,
+        u1: R,
+        rng: &mut impl LaneRandom<R>,
+    ) -> LaneSample<R> {
         match self {
             LaneBsdf::Lambert { reflectance } => {
                 let s = upper(wo);
@@ -348,6 +461,43 @@ impl LaneBsdf {
                 transmit_tint,
             } => {
                 Self::dielectric_sample(ndf, *eta, reflect_tint, transmit_tint, wo, u_lobe, u0, u1)
+            }
+            LaneBsdf::Il {
+                ndf,
+                ni,
+                body,
+                specular_probability,
+            } => {
+                // The specular lobe's visible-normal reflection or the cosine lobe, then the
+                // value and density of the pair (the f64 model's order of draws).
+                let s = upper(wo);
+                let o = mirror(wo, s);
+                let specular = u_lobe.lt(R::splat(*specular_probability));
+                let m = ndf.sample_visible(o, u0, u1);
+                let c = o.dot(m);
+                let reflected = m.scale(R::splat(2.0) * c) - o;
+                let i = LVec3::select(specular, reflected, cosine_hemisphere(u0, u1));
+                let lobe_pdf = ndf.pdf_visible(o, m, ndf.d(m)) / (R::splat(4.0) * c);
+                let lobe_ok = c.gt(R::zero()) & lobe_pdf.gt(R::zero()) & lobe_pdf.is_finite();
+                let drawn = !wo.z.eq(R::zero()) & i.z.gt(R::zero()) & (!specular | lobe_ok);
+                let (spec, pdf) = Self::il_specular(ndf, *ni, *specular_probability, o, i);
+                let valued = drawn & pdf.gt(R::zero());
+                let (b0, b1) = rng.next_2d(valued);
+                let b = Self::il_body(ndf, *ni, o, i, b0, b1);
+                let k = i.z / pdf;
+                let weight: [R; 3] = std::array::from_fn(|ch| (spec + R::splat(body[ch]) * b) * k);
+                let ok = valued
+                    & weight[0].is_finite()
+                    & weight[1].is_finite()
+                    & weight[2].is_finite();
+                LaneSample {
+                    wi: mirror(i, s),
+                    weight,
+                    pdf,
+                    eta: R::one(),
+                    transmitted: R::Mask::splat(false),
+                    ok,
+                }
             }
         }
     }
@@ -424,18 +574,42 @@ mod tests {
     use crate::recipe::MaterialRecipe;
     use crate::{Bsdf, BsdfContext};
 
-    /// A source that returns the direction numbers, then the lobe number (the order of the
-    /// f64 models' draws), then fails loudly.
+    /// A source that returns the lobe number and the direction numbers (in whichever order
+    /// the f64 model draws them), then further pairs from `free` (a stochastic model's
+    /// draws from the free stream); a second lobe number fails loudly.
     struct Fixed {
         dir: Option<Vec2>,
         lobe: Option<f64>,
+        free: Pcg32,
     }
     impl RandomSource for Fixed {
         fn next_f64(&mut self) -> f64 {
             self.lobe.take().expect("one lobe number")
         }
         fn next_2d(&mut self) -> Vec2 {
-            self.dir.take().expect("one direction")
+            self.dir.take().unwrap_or_else(|| self.free.next_2d())
+        }
+    }
+
+    /// The lane side of the free stream: one pair from the generator for each lane asked,
+    /// in lane order (one lane here: the f64 instantiation).
+    struct FreeLanes(Pcg32);
+    impl LaneRandom<f64> for FreeLanes {
+        fn next_2d(&mut self, lanes: bool) -> (f64, f64) {
+            if lanes {
+                let u = self.0.next_2d();
+                (u.x, u.y)
+            } else {
+                (f64::NAN, f64::NAN)
+            }
+        }
+    }
+
+    /// Given numbers, whatever the lanes asked (the f32/f64 comparison draws them itself).
+    struct Given<R>(R, R);
+    impl<R: Real> LaneRandom<R> for Given<R> {
+        fn next_2d(&mut self, _: R::Mask) -> (R, R) {
+            (self.0, self.1)
         }
     }
 
@@ -472,6 +646,19 @@ mod tests {
                alpha_u = 0.1
                alpha_v = 0.7
                ior = 0.66"#,
+            r#"type = "il"
+               kd = [0.7, 0.28, 0.1]
+               ni = 1.5
+               distribution = "beckmann"
+               alpha = 0.3
+               masking = "smith""#,
+            r#"type = "il"
+               kd = [0.9, 0.5, 0.2]
+               ni = 2.0
+               distribution = "ggx"
+               alpha_u = 0.1
+               alpha_v = 0.6
+               masking = "smith""#,
         ]
         .iter()
         .map(|s| s.parse().unwrap())
@@ -502,10 +689,12 @@ mod tests {
         let ctx = BsdfContext::RADIANCE;
         let mut rng = Pcg32::new(7, 1);
         for (lane, model) in models() {
-            for _ in 0..4000 {
+            for k in 0..4000 {
                 let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
-                let (v, p) = lane.eval_pdf::<f64>(wo.into(), wi.into());
-                let want = model.eval(wo, wi, &ctx, &mut rng);
+                // The stochastic IL body: both sides draw from equal streams.
+                let free = Pcg32::new(k, 11);
+                let (v, p) = lane.eval_pdf::<f64>(wo.into(), wi.into(), &mut FreeLanes(free.clone()));
+                let want = model.eval(wo, wi, &ctx, &mut free.clone());
                 let want_pdf = model.pdf(wo, wi, &ctx);
                 for c in 0..3 {
                     assert!(
@@ -529,13 +718,15 @@ mod tests {
         let mut rng = Pcg32::new(8, 3);
         for (lane, model) in models() {
             let mut taken = 0;
-            for _ in 0..4000 {
+            for k in 0..4000 {
                 let wo = random_dir(&mut rng);
                 let (ul, ud) = (rng.next_f64(), rng.next_2d());
-                let s = lane.sample::<f64>(wo.into(), ul, ud.x, ud.y);
+                let free = Pcg32::new(k, 12);
+                let s = lane.sample::<f64>(wo.into(), ul, ud.x, ud.y, &mut FreeLanes(free.clone()));
                 let mut src = Fixed {
                     dir: Some(ud),
                     lobe: Some(ul),
+                    free,
                 };
                 let want = model.sample(wo, &ctx, &mut src);
                 match want {
@@ -602,8 +793,8 @@ mod tests {
             for _ in 0..500 {
                 let wo = LVec3::<f64>::from_fn(|_| random_dir(&mut rng));
                 let (u0, u1) = (rng.next_f64(), rng.next_f64());
-                let a = lane.sample(wo, 0.0, u0, u1);
-                let b = lane.sample(wo, 0.999, u0, u1);
+                let a = lane.sample(wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
+                let b = lane.sample(wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
                 assert_eq!(a.ok, b.ok);
                 if a.ok {
                     assert_eq!(a.wi.lane(0), b.wi.lane(0));
@@ -619,26 +810,45 @@ mod tests {
     #[test]
     fn f32x8_lanes_match_f64_lanes() {
         let mut rng = Pcg32::new(9, 5);
+        let (mut skipped, mut compared) = (0, 0);
         for (lane, model) in models() {
             for _ in 0..500 {
                 let wo: [Vec3; 8] = std::array::from_fn(|_| random_dir(&mut rng));
                 let wi: [Vec3; 8] = std::array::from_fn(|_| random_dir(&mut rng));
-                let u: [[f64; 3]; 8] =
-                    std::array::from_fn(|_| [rng.next_f64(), rng.next_f64(), rng.next_f64()]);
+                let u: [[f64; 5]; 8] = std::array::from_fn(|_| std::array::from_fn(|_| rng.next_f64()));
                 let wo8 = LVec3::<F32x8>::from_fn(|i| wo[i]);
                 let wi8 = LVec3::<F32x8>::from_fn(|i| wi[i]);
-                let (v8, p8) = lane.eval_pdf(wo8, wi8);
+                let free8 = || Given(F32x8::from_fn(|i| u[i][3]), F32x8::from_fn(|i| u[i][4]));
+                let (v8, p8) = lane.eval_pdf(wo8, wi8, &mut free8());
                 let s8 = lane.sample(
                     wo8,
                     F32x8::from_fn(|i| u[i][0]),
                     F32x8::from_fn(|i| u[i][1]),
                     F32x8::from_fn(|i| u[i][2]),
+                    &mut free8(),
                 );
                 for i in 0..8 {
-                    let (v, p) = lane.eval_pdf::<f64>(wo[i].into(), wi[i].into());
-                    // f32 directions move a grazing or near-specular value by more than its
-                    // rounding: compare where the pair is not within 1e-3 of an edge.
-                    if wo[i].z.abs() > 1e-2 && wi[i].z.abs() > 1e-2 && p < 1e3 {
+                    // The f64 reference at the f32 inputs, so that only the arithmetic differs.
+                    let f32_in = |x: f64| x as f32 as f64;
+                    let free = || Given(f32_in(u[i][3]), f32_in(u[i][4]));
+                    let (wo_i, wi_i) = (wo8.lane(i), wi8.lane(i));
+                    let (v, p) = lane.eval_pdf::<f64>(wo_i.into(), wi_i.into(), &mut free());
+                    // f32 arithmetic moves an ill-conditioned value by more than its rounding
+                    // (grazing pairs, near-specular peaks, Fresnel at the critical angle,
+                    // where 1 − F ∝ √(cos − cos_c)): compare where moving wi by 1e-6 moves
+                    // the f64 value and density by less than 1e-4.
+                    let (vp, pp) = lane.eval_pdf::<f64>(
+                        wo_i.into(),
+                        (wi_i + Vec3::splat(1e-6)).normalize().into(),
+                        &mut free(),
+                    );
+                    let steady = |a: f64, b: f64| (a - b).abs() <= 1e-4 * a.abs().max(1e-3);
+                    let conditioned = steady(p, pp) && (0..3).all(|c| steady(v[c], vp[c]));
+                    if !conditioned {
+                        skipped += 1;
+                    }
+                    compared += 1;
+                    if wo[i].z.abs() > 1e-2 && wi[i].z.abs() > 1e-2 && p < 1e3 && conditioned {
                         assert!(
                             close(p8.lane(i), p, 2e-3),
                             "{}: pdf {} vs {p}",
@@ -648,14 +858,20 @@ mod tests {
                         for c in 0..3 {
                             assert!(
                                 close(v8[c].lane(i), v[c], 2e-3),
-                                "{}: f {} vs {}",
+                                "{}: f {} vs {} at {wo_i}, {wi_i}",
                                 model.describe(),
                                 v8[c].lane(i),
                                 v[c]
                             );
                         }
                     }
-                    let s = lane.sample::<f64>(wo[i].into(), u[i][0], u[i][1], u[i][2]);
+                    let s = lane.sample::<f64>(
+                        wo_i.into(),
+                        f32_in(u[i][0]),
+                        f32_in(u[i][1]),
+                        f32_in(u[i][2]),
+                        &mut free(),
+                    );
                     let same_lobe = s.transmitted == s8.transmitted.lane(i);
                     if s.ok && s8.ok.lane(i) && same_lobe && wo[i].z.abs() > 1e-2 && s.pdf < 1e3 {
                         assert!(
@@ -667,5 +883,7 @@ mod tests {
                 }
             }
         }
+        println!("f32x8 against f64: {skipped} of {compared} pairs ill-conditioned, not compared");
+        assert!(skipped * 50 < compared, "{skipped} of {compared} skipped");
     }
 }

@@ -31,7 +31,7 @@ pub mod rough_dielectric;
 pub use il::InterfacedLambertian;
 pub use kelemen::Kelemen;
 pub use lambert::Lambert;
-pub use lane_models::{LaneBsdf, LaneFresnel, LaneNdf, LaneSample};
+pub use lane_models::{LaneBsdf, LaneFresnel, LaneNdf, LaneRandom, LaneSample};
 pub use multiple_scattering::{
     CompensatedConductor, CompensatedDielectric, MultipleScatteringConductor,
     MultipleScatteringDielectric,

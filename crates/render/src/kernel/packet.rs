@@ -39,7 +39,8 @@ use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
 use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LFrame, LVec3, M64x8, Mask, Real, U32x8};
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
-use facette_bsdf::models::LaneBsdf;
+use facette_bsdf::math::rng::RandomSource;
+use facette_bsdf::models::{LaneBsdf, LaneRandom};
 use facette_bsdf::{BsdfContext, LobeFlags, Spectrum};
 use std::ops::Range;
 
@@ -785,7 +786,11 @@ impl Kernel<'_> {
                         .filter(|&i| matches!(&bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, *model)))
                         .fold(0, |s, i| s | (1 << i));
                     todo &= !group;
-                    let (v, p) = model.eval_pdf(wo, wi);
+                    let mut free = FreeNumbers {
+                        streams: &mut paths.streams,
+                        group,
+                    };
+                    let (v, p) = model.eval_pdf(wo, wi, &mut free);
                     for c in 0..3 {
                         f[c] = merge(group, v[c] * cos, f[c]);
                     }
@@ -868,7 +873,11 @@ impl Kernel<'_> {
                     )
                     .fold(0, |s, i| s | (1 << i));
                 todo &= !group;
-                let s = model.sample(wo, u_lobe, u0, u1);
+                let mut free = FreeNumbers {
+                    streams: &mut paths.streams,
+                    group,
+                };
+                let s = model.sample(wo, u_lobe, u0, u1, &mut free);
                 let m = mask::<S>(group);
                 wi = LVec3::select(m, s.wi, wi);
                 for (w, sw) in weight.iter_mut().zip(s.weight) {
@@ -958,6 +967,27 @@ impl Kernel<'_> {
     }
 }
 
+/// A lane model's further random numbers: each lane's free PCG stream, as the scalar
+/// integrator's stochastic models draw them, for the lanes of the model's group that ask.
+struct FreeNumbers<'a> {
+    streams: &'a mut [SampleStream; LANES],
+    group: Lanes,
+}
+
+impl<S: Real> LaneRandom<S> for FreeNumbers<'_> {
+    #[inline(always)]
+    fn next_2d(&mut self, lanes: S::Mask) -> (S, S) {
+        let mut u = [[0.0; 2]; LANES];
+        for i in lanes_of(self.group) {
+            if lanes.lane(i) {
+                let d = self.streams[i].rng().next_2d();
+                u[i] = [d.x, d.y];
+            }
+        }
+        (S::from_fn(|i| u[i][0]), S::from_fn(|i| u[i][1]))
+    }
+}
+
 /// The constant environment's density of a direction: uniform over the sphere.
 #[inline(always)]
 fn constant_pdf(c: &ConstantEnvironment) -> f64 {
@@ -1008,6 +1038,12 @@ mod tests {
         gold = { type = "conductor", distribution = "ggx", alpha = 0.3, material = "Au" }
         glass = { type = "dielectric", distribution = "beckmann", alpha = 0.3, ior = 1.5 }
         clay = { type = "oren-nayar", reflectance = 0.6, sigma = 0.35 }
+        plastic = { type = "il", kd = [0.7, 0.28, 0.1], ni = 1.5, distribution = "beckmann", alpha = 0.3, masking = "smith" }
+        [[objects]]
+        shape = "sphere"
+        center = [0.5, 0.7, -0.6]
+        radius = 0.4
+        material = "plastic"
         [[objects]]
         shape = "rectangle"
         transform = [{ rotate = { axis = [1, 0, 0], angle = -90 } }, { scale = 4 }, { translate = [0, -0.5, 0] }]
@@ -1043,7 +1079,8 @@ mod tests {
     /// With f64 shading lanes the packet kernel is the scalar integrator in another order:
     /// every pixel agrees to 1e-9 for every sampler and estimator (the lane models differ
     /// from the f64 models only in how they write the sampling weight and the dielectric's
-    /// Fresnel term); f32 lanes render every sample too.
+    /// Fresnel term; the stochastic IL body draws the same free-stream numbers); f32 lanes
+    /// render every sample too.
     #[test]
     fn f64_lanes_reproduce_the_scalar_integrator_sample_for_sample() {
         let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();

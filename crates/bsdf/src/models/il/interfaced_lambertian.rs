@@ -243,6 +243,17 @@ impl InterfacedLambertian {
         self.ri
     }
 
+    /// K_d/(n_i² (1 − K_d r_i)) per channel: the body term's prefactor without 1/π
+    /// [IL18 eq. 13].
+    pub fn body_factor(&self) -> Spectrum {
+        self.body_factor
+    }
+
+    /// The probability of sampling the specular lobe (rough IL) [IL18 §4.1].
+    pub fn specular_probability(&self) -> f64 {
+        self.specular_probability
+    }
+
     pub fn lobe(&self) -> Option<&SpecularLobe> {
         self.lobe.as_ref()
     }

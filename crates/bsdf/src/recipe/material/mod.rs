@@ -174,6 +174,25 @@ impl MaterialRecipe {
                 reflect_tint: reflect_tint.0,
                 transmit_tint: transmit_tint.0,
             }),
+            MaterialRecipe::Il {
+                kd,
+                ni,
+                lobe: lobe @ Some(_),
+                evaluation: il::IlEvaluation::Stochastic,
+                scattering: crate::models::il::interfaced_lambertian::Scattering::Single,
+                multiple_tolerance: None,
+            } => {
+                let ndf = lobe_ndf(lobe)?;
+                let model = crate::models::il::InterfacedLambertian::new(
+                    *kd,
+                    *ni,
+                    lobe.clone(),
+                    crate::models::il::interfaced_lambertian::BodyEvaluation::Stochastic,
+                    crate::models::il::interfaced_lambertian::Scattering::Single,
+                )
+                .ok()?;
+                Some(LaneBsdf::il(ndf, &model))
+            }
             _ => None,
         }
     }
