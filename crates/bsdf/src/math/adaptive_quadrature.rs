@@ -11,6 +11,9 @@
 //!   microfacet integrals: the polar angles where a facet turns away from i or o, or where
 //!   the V-cavity masking changes branch, at each azimuth). Half of the tolerance goes to the
 //!   inner integrals, half to the outer rule.
+//! - [`integrate_graded`], [`integrate_2d_graded`]: the same, with the range given as cuts
+//!   and each piece between cuts mapped by a cubic that clusters the nodes at its ends, for
+//!   integrands that behave like a square root at a cut (the albedo tables' entries).
 //!
 //! **Error estimate.** Each K15 value carries QUADPACK's QK15 estimate, built from the
 //! difference with the embedded 7-point Gauss rule (see `quadrature::gk15_weighted`): close
