@@ -486,10 +486,8 @@ impl LaneBsdf {
                 let b = Self::il_body(ndf, *ni, o, i, b0, b1);
                 let k = i.z / pdf;
                 let weight: [R; 3] = std::array::from_fn(|ch| (spec + R::splat(body[ch]) * b) * k);
-                let ok = valued
-                    & weight[0].is_finite()
-                    & weight[1].is_finite()
-                    & weight[2].is_finite();
+                let ok =
+                    valued & weight[0].is_finite() & weight[1].is_finite() & weight[2].is_finite();
                 LaneSample {
                     wi: mirror(i, s),
                     weight,
@@ -693,7 +691,8 @@ mod tests {
                 let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
                 // The stochastic IL body: both sides draw from equal streams.
                 let free = Pcg32::new(k, 11);
-                let (v, p) = lane.eval_pdf::<f64>(wo.into(), wi.into(), &mut FreeLanes(free.clone()));
+                let (v, p) =
+                    lane.eval_pdf::<f64>(wo.into(), wi.into(), &mut FreeLanes(free.clone()));
                 let want = model.eval(wo, wi, &ctx, &mut free.clone());
                 let want_pdf = model.pdf(wo, wi, &ctx);
                 for c in 0..3 {
@@ -815,7 +814,8 @@ mod tests {
             for _ in 0..500 {
                 let wo: [Vec3; 8] = std::array::from_fn(|_| random_dir(&mut rng));
                 let wi: [Vec3; 8] = std::array::from_fn(|_| random_dir(&mut rng));
-                let u: [[f64; 5]; 8] = std::array::from_fn(|_| std::array::from_fn(|_| rng.next_f64()));
+                let u: [[f64; 5]; 8] =
+                    std::array::from_fn(|_| std::array::from_fn(|_| rng.next_f64()));
                 let wo8 = LVec3::<F32x8>::from_fn(|i| wo[i]);
                 let wi8 = LVec3::<F32x8>::from_fn(|i| wi[i]);
                 let free8 = || Given(F32x8::from_fn(|i| u[i][3]), F32x8::from_fn(|i| u[i][4]));
