@@ -338,6 +338,7 @@ pub fn integrate_2d_graded(
         rel: 0.5 * tol.rel,
         abs: 0.5 * tol.abs / width.max(f64::MIN_POSITIVE),
         max_segments: tol.max_segments,
+        estimate: tol.estimate,
     };
     let mut evaluations = 0usize;
     let mut inner_converged = true;
