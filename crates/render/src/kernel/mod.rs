@@ -7,6 +7,7 @@
 //!
 //! [`integrator::radiance`]: crate::integrator::radiance
 
+mod model_calls;
 pub mod packet;
 
 /// A render kernel.

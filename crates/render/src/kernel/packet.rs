@@ -26,6 +26,7 @@
 //! is compiled twice, for the baseline (SSE2: an 8-lane f32 operation is two instructions)
 //! and for AVX2 + FMA, chosen at run time.
 
+use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
 use crate::geometry::ray::offset_origin_lanes;
 use crate::geometry::{HitLanes, LaneRays, RayDifferential, Vec3};
@@ -54,22 +55,22 @@ type Lanes = u8;
 type G = F64x8;
 
 #[inline(always)]
-fn to_s<S: Real>(x: G) -> S {
+fn to_s<S: ShadingLanes>(x: G) -> S {
     S::from_fn(|i| x.0[i])
 }
 
 #[inline(always)]
-fn to_g<S: Real>(x: S) -> G {
+fn to_g<S: ShadingLanes>(x: S) -> G {
     F64x8(std::array::from_fn(|i| x.lane(i)))
 }
 
 #[inline(always)]
-fn vec_s<S: Real>(v: LVec3<G>) -> LVec3<S> {
+fn vec_s<S: ShadingLanes>(v: LVec3<G>) -> LVec3<S> {
     LVec3::new(to_s(v.x), to_s(v.y), to_s(v.z))
 }
 
 #[inline(always)]
-fn vec_g<S: Real>(v: LVec3<S>) -> LVec3<G> {
+fn vec_g<S: ShadingLanes>(v: LVec3<S>) -> LVec3<G> {
     LVec3::new(to_g(v.x), to_g(v.y), to_g(v.z))
 }
 
@@ -95,18 +96,18 @@ fn merge<R: Real>(set: Lanes, v: R, keep: R) -> R {
 type Rgb<S> = [S; 3];
 
 #[inline(always)]
-fn rgb_splat<S: Real>(c: Spectrum) -> Rgb<S> {
+fn rgb_splat<S: ShadingLanes>(c: Spectrum) -> Rgb<S> {
     std::array::from_fn(|k| S::splat(c[k]))
 }
 
 #[inline(always)]
-fn rgb_lane<S: Real>(c: &Rgb<S>, i: usize) -> Spectrum {
+fn rgb_lane<S: ShadingLanes>(c: &Rgb<S>, i: usize) -> Spectrum {
     Spectrum([c[0].lane(i), c[1].lane(i), c[2].lane(i)])
 }
 
 /// Sets lane `i` of a spectrum to `v`.
 #[inline(always)]
-fn rgb_set<S: Real>(c: &mut Rgb<S>, i: usize, v: Spectrum) {
+fn rgb_set<S: ShadingLanes>(c: &mut Rgb<S>, i: usize, v: Spectrum) {
     for k in 0..3 {
         let old = c[k];
         c[k] = S::from_fn(|j| if j == i { v[k] } else { old.lane(j) });
@@ -211,7 +212,7 @@ pub(crate) struct TileJob<'a> {
 /// number of rows started (a stop leaves the later rows out).
 pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if super::model_calls::avx2_fma() {
         // SAFETY: the CPU has the features the function is compiled for.
         return unsafe { render_tile_avx2(job, sums) };
     }
@@ -226,7 +227,10 @@ unsafe fn render_tile_avx2(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
 
 /// [`render_tile`] with shading lanes `S` (8 lanes: `F32x8`, or `F64x8` in the tests).
 #[inline(always)]
-pub(crate) fn render_tile_lanes<S: Real>(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
+pub(crate) fn render_tile_lanes<S: ShadingLanes>(
+    job: &TileJob,
+    sums: &mut Vec<PixelSums>,
+) -> usize {
     debug_assert_eq!(S::LANES, LANES);
     sums.clear();
     sums.resize(job.xs.len() * job.ys.len(), PixelSums::default());
@@ -303,7 +307,12 @@ enum VertexBsdf<'s> {
 impl Kernel<'_> {
     /// Fills the empty lanes with camera rays, making a new batch when the last is used up.
     #[inline(always)]
-    fn refill<S: Real>(&self, paths: &mut Paths<S>, batch: &mut CameraBatch, jobs: &mut Jobs) {
+    fn refill<S: ShadingLanes>(
+        &self,
+        paths: &mut Paths<S>,
+        batch: &mut CameraBatch,
+        jobs: &mut Jobs,
+    ) {
         let mut filled: Lanes = 0;
         for i in 0..LANES {
             if paths.live & (1 << i) != 0 {
@@ -348,7 +357,7 @@ impl Kernel<'_> {
 
     /// The camera rays of the next (up to) eight jobs; `false` when no job is left.
     #[inline(always)]
-    fn make_batch<S: Real>(&self, batch: &mut CameraBatch, jobs: &mut Jobs) -> bool {
+    fn make_batch<S: ShadingLanes>(&self, batch: &mut CameraBatch, jobs: &mut Jobs) -> bool {
         let mut px = [0.0; LANES];
         let mut py = [0.0; LANES];
         let mut n = 0;
@@ -411,7 +420,7 @@ impl Kernel<'_> {
     /// MIS weight of emission found by the BSDF sample of the previous vertex, whose
     /// density was `prev_pdf`, against light sampling's density `pl`.
     #[inline(always)]
-    fn emission_weight<S: Real>(&self, delta_prev: Lanes, prev_pdf: S, pl: S) -> S {
+    fn emission_weight<S: ShadingLanes>(&self, delta_prev: Lanes, prev_pdf: S, pl: S) -> S {
         let w = match self.strategy {
             Strategy::Mis => power_heuristic_lanes(prev_pdf, pl),
             Strategy::NeeOnly => S::zero(),
@@ -422,7 +431,7 @@ impl Kernel<'_> {
 
     /// Adds `beta · le · w` to the lanes of `set`.
     #[inline(always)]
-    fn add_radiance<S: Real>(paths: &mut Paths<S>, set: Lanes, le: &Rgb<S>, w: S) {
+    fn add_radiance<S: ShadingLanes>(paths: &mut Paths<S>, set: Lanes, le: &Rgb<S>, w: S) {
         for ((l, beta), le) in paths.l.iter_mut().zip(&paths.beta).zip(le) {
             *l = merge(set, *l + *beta * *le * w, *l);
         }
@@ -430,7 +439,7 @@ impl Kernel<'_> {
 
     /// Ends the paths of `set`: their radiance goes to their pixels.
     #[inline(always)]
-    fn finish<S: Real>(paths: &mut Paths<S>, set: Lanes, sums: &mut [PixelSums]) {
+    fn finish<S: ShadingLanes>(paths: &mut Paths<S>, set: Lanes, sums: &mut [PixelSums]) {
         for i in lanes_of(set) {
             sums[paths.slot[i] as usize].add(rgb_lane(&paths.l, i));
         }
@@ -439,7 +448,7 @@ impl Kernel<'_> {
 
     /// Advances every live lane by one path segment.
     #[inline(always)]
-    fn step<S: Real>(&self, paths: &mut Paths<S>, sums: &mut [PixelSums]) {
+    fn step<S: ShadingLanes>(&self, paths: &mut Paths<S>, sums: &mut [PixelSums]) {
         let scene = self.scene;
         let rays = LaneRays::new(paths.o, paths.d, G::splat(f64::INFINITY), paths.live);
         let hits = scene.geometry.intersect_lanes(&rays);
@@ -515,7 +524,7 @@ impl Kernel<'_> {
 
     /// Emission seen by the rays of `missed` leaving the scene.
     #[inline(always)]
-    fn environment<S: Real>(&self, paths: &mut Paths<S>, missed: Lanes) {
+    fn environment<S: ShadingLanes>(&self, paths: &mut Paths<S>, missed: Lanes) {
         let scene = self.scene;
         let Some(env) = scene.environment else { return };
         let Light::Environment(e) = &scene.lights[env as usize] else {
@@ -556,7 +565,7 @@ impl Kernel<'_> {
 
     /// Emission of the area lights the hits of `hl` lie on.
     #[inline(always)]
-    fn area_emission<S: Real>(&self, paths: &mut Paths<S>, hl: &HitLanes) {
+    fn area_emission<S: ShadingLanes>(&self, paths: &mut Paths<S>, hl: &HitLanes) {
         let scene = self.scene;
         for i in lanes_of(hl.lanes & paths.live) {
             let Some(li) = scene.shape_light[hl.shape[i] as usize] else {
@@ -591,7 +600,7 @@ impl Kernel<'_> {
     /// values and densities, one packet of shadow rays.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn next_event<S: Real>(
+    fn next_event<S: ShadingLanes>(
         &self,
         paths: &mut Paths<S>,
         hl: &HitLanes,
@@ -766,7 +775,7 @@ impl Kernel<'_> {
     /// call per lane model present, the f64 models lane by lane.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn eval_materials<S: Real>(
+    fn eval_materials<S: ShadingLanes>(
         &self,
         paths: &mut Paths<S>,
         bsdfs: &[VertexBsdf; LANES],
@@ -790,7 +799,7 @@ impl Kernel<'_> {
                         streams: &mut paths.streams,
                         group,
                     };
-                    let (v, p) = model.eval_pdf(wo, wi, &mut free);
+                    let (v, p) = S::eval_pdf(model, wo, wi, &mut free);
                     for c in 0..3 {
                         f[c] = merge(group, v[c] * cos, f[c]);
                     }
@@ -816,7 +825,7 @@ impl Kernel<'_> {
     /// that end are finished.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn continue_paths<S: Real>(
+    fn continue_paths<S: ShadingLanes>(
         &self,
         paths: &mut Paths<S>,
         hl: &HitLanes,
@@ -877,7 +886,7 @@ impl Kernel<'_> {
                     streams: &mut paths.streams,
                     group,
                 };
-                let s = model.sample(wo, u_lobe, u0, u1, &mut free);
+                let s = S::sample(model, wo, u_lobe, u0, u1, &mut free);
                 let m = mask::<S>(group);
                 wi = LVec3::select(m, s.wi, wi);
                 for (w, sw) in weight.iter_mut().zip(s.weight) {
@@ -996,7 +1005,7 @@ fn constant_pdf(c: &ConstantEnvironment) -> f64 {
 
 /// [`power_heuristic`] over lanes.
 #[inline(always)]
-fn power_heuristic_lanes<S: Real>(a: S, b: S) -> S {
+fn power_heuristic_lanes<S: ShadingLanes>(a: S, b: S) -> S {
     let (a2, b2) = (a * a, b * b);
     let sum = a2 + b2;
     S::select(sum.eq(S::zero()), S::zero(), a2 / sum)

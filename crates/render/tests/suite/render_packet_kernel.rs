@@ -119,7 +119,7 @@ fn packet_and_scalar_kernels_render_the_same_image() {
     // "black" is the emitter's implicit material.
     assert_eq!(
         lane_models,
-        ["black", "brushed", "frosted", "glass", "gold", "schlick", "white"],
+        ["black", "brushed", "coated", "frosted", "glass", "gold", "schlick", "white"],
         "the materials with lane models"
     );
     let spp = 32;

@@ -1,0 +1,151 @@
+//! The packet kernel's calls into the lane models, each compiled as a function of its own.
+//!
+//! The lane models' code is `#[inline(always)]` so that it compiles with the instruction
+//! set of the function it lands in (AVX2 + FMA in the kernel). Inlined into the kernel's
+//! loops, though, every model with both distributions and Beckmann's inverse-CDF sampler
+//! made the whole bounce one function of a size where LLVM's loop and memory passes (LICM's
+//! predecessor walks, MemorySSA renaming), which grow faster than linearly with it, kept the
+//! render crate's test build busy for over 30 minutes on one core. Here each model call is
+//! one function per lane type, compiled for AVX2 + FMA where the CPU has them: a call per
+//! model group and bounce, nothing next to the model's own work.
+
+use facette_bsdf::lanes::{F32x8, F64x8, LVec3, Real};
+use facette_bsdf::models::{LaneBsdf, LaneRandom, LaneSample};
+
+/// A lane type the kernel shades with, and how it calls the lane models.
+pub(crate) trait ShadingLanes: Real {
+    /// [`LaneBsdf::eval_pdf`], out of line.
+    fn eval_pdf(
+        model: &LaneBsdf,
+        wo: LVec3<Self>,
+        wi: LVec3<Self>,
+        rng: &mut impl LaneRandom<Self>,
+    ) -> ([Self; 3], Self);
+
+    /// [`LaneBsdf::sample`], out of line.
+    fn sample(
+        model: &LaneBsdf,
+        wo: LVec3<Self>,
+        u_lobe: Self,
+        u0: Self,
+        u1: Self,
+        rng: &mut impl LaneRandom<Self>,
+    ) -> LaneSample<Self>;
+}
+
+#[inline(never)]
+fn eval_pdf_portable<S: Real>(
+    model: &LaneBsdf,
+    wo: LVec3<S>,
+    wi: LVec3<S>,
+    rng: &mut impl LaneRandom<S>,
+) -> ([S; 3], S) {
+    model.eval_pdf(wo, wi, rng)
+}
+
+#[inline(never)]
+fn sample_portable<S: Real>(
+    model: &LaneBsdf,
+    wo: LVec3<S>,
+    u_lobe: S,
+    u0: S,
+    u1: S,
+    rng: &mut impl LaneRandom<S>,
+) -> LaneSample<S> {
+    model.sample(wo, u_lobe, u0, u1, rng)
+}
+
+/// f64 lanes (the test that finds the scalar integrator's image): the baseline build.
+impl ShadingLanes for F64x8 {
+    #[inline(always)]
+    fn eval_pdf(
+        model: &LaneBsdf,
+        wo: LVec3<Self>,
+        wi: LVec3<Self>,
+        rng: &mut impl LaneRandom<Self>,
+    ) -> ([Self; 3], Self) {
+        eval_pdf_portable(model, wo, wi, rng)
+    }
+
+    #[inline(always)]
+    fn sample(
+        model: &LaneBsdf,
+        wo: LVec3<Self>,
+        u_lobe: Self,
+        u0: Self,
+        u1: Self,
+        rng: &mut impl LaneRandom<Self>,
+    ) -> LaneSample<Self> {
+        sample_portable(model, wo, u_lobe, u0, u1, rng)
+    }
+}
+
+/// f32 lanes (renders): the AVX2 + FMA build where the CPU has them (the feature test is
+/// a cached flag), the baseline build elsewhere.
+impl ShadingLanes for F32x8 {
+    #[inline(always)]
+    fn eval_pdf(
+        model: &LaneBsdf,
+        wo: LVec3<Self>,
+        wi: LVec3<Self>,
+        rng: &mut impl LaneRandom<Self>,
+    ) -> ([Self; 3], Self) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2_fma() {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { eval_pdf_avx2(model, wo, wi, rng) };
+        }
+        eval_pdf_portable(model, wo, wi, rng)
+    }
+
+    #[inline(always)]
+    fn sample(
+        model: &LaneBsdf,
+        wo: LVec3<Self>,
+        u_lobe: Self,
+        u0: Self,
+        u1: Self,
+        rng: &mut impl LaneRandom<Self>,
+    ) -> LaneSample<Self> {
+        #[cfg(target_arch = "x86_64")]
+        if avx2_fma() {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { sample_avx2(model, wo, u_lobe, u0, u1, rng) };
+        }
+        sample_portable(model, wo, u_lobe, u0, u1, rng)
+    }
+}
+
+/// Whether this CPU runs AVX2 and FMA (what [`render_tile`](super::packet::render_tile)
+/// tests to choose its build).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn avx2_fma() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+fn eval_pdf_avx2(
+    model: &LaneBsdf,
+    wo: LVec3<F32x8>,
+    wi: LVec3<F32x8>,
+    rng: &mut impl LaneRandom<F32x8>,
+) -> ([F32x8; 3], F32x8) {
+    model.eval_pdf(wo, wi, rng)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+fn sample_avx2(
+    model: &LaneBsdf,
+    wo: LVec3<F32x8>,
+    u_lobe: F32x8,
+    u0: F32x8,
+    u1: F32x8,
+    rng: &mut impl LaneRandom<F32x8>,
+) -> LaneSample<F32x8> {
+    model.sample(wo, u_lobe, u0, u1, rng)
+}
