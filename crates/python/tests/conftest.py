@@ -11,8 +11,10 @@ REPO = pathlib.Path(__file__).resolve().parents[3]
 @pytest.fixture(scope="session")
 def facette_bin():
     """The `facette` binary of this checkout, as the README's test command builds it
-    (`cargo test --workspace --profile optimized-tests`)."""
-    path = os.environ.get("FACETTE_BIN") or str(REPO / "target" / "optimized-tests" / "facette")
+    (`cargo test --workspace --profile optimized-tests`), in CARGO_TARGET_DIR where that is
+    set; FACETTE_BIN names another."""
+    target = pathlib.Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
+    path = os.environ.get("FACETTE_BIN") or str(target / "optimized-tests" / "facette")
     if not os.path.exists(path):
         subprocess.run(
             ["cargo", "build", "--profile", "optimized-tests", "-p", "facette"],

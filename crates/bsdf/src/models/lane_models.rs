@@ -611,6 +611,31 @@ mod tests {
         }
     }
 
+    /// The model calls out of line: inlined into these loops (every model, both
+    /// distributions), they make functions whose optimization grows faster than linearly
+    /// with their size and cost the test build minutes.
+    #[inline(never)]
+    fn eval_pdf_of<R: Real>(
+        lane: &LaneBsdf,
+        wo: LVec3<R>,
+        wi: LVec3<R>,
+        rng: &mut impl LaneRandom<R>,
+    ) -> ([R; 3], R) {
+        lane.eval_pdf(wo, wi, rng)
+    }
+
+    #[inline(never)]
+    fn sample_of<R: Real>(
+        lane: &LaneBsdf,
+        wo: LVec3<R>,
+        u_lobe: R,
+        u0: R,
+        u1: R,
+        rng: &mut impl LaneRandom<R>,
+    ) -> LaneSample<R> {
+        lane.sample(wo, u_lobe, u0, u1, rng)
+    }
+
     fn materials() -> Vec<toml::Table> {
         [
             r#"type = "lambert"
@@ -691,8 +716,7 @@ mod tests {
                 let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
                 // The stochastic IL body: both sides draw from equal streams.
                 let free = Pcg32::new(k, 11);
-                let (v, p) =
-                    lane.eval_pdf::<f64>(wo.into(), wi.into(), &mut FreeLanes(free.clone()));
+                let (v, p) = eval_pdf_of(&lane, wo.into(), wi.into(), &mut FreeLanes(free.clone()));
                 let want = model.eval(wo, wi, &ctx, &mut free.clone());
                 let want_pdf = model.pdf(wo, wi, &ctx);
                 for c in 0..3 {
@@ -721,7 +745,14 @@ mod tests {
                 let wo = random_dir(&mut rng);
                 let (ul, ud) = (rng.next_f64(), rng.next_2d());
                 let free = Pcg32::new(k, 12);
-                let s = lane.sample::<f64>(wo.into(), ul, ud.x, ud.y, &mut FreeLanes(free.clone()));
+                let s = sample_of(
+                    &lane,
+                    wo.into(),
+                    ul,
+                    ud.x,
+                    ud.y,
+                    &mut FreeLanes(free.clone()),
+                );
                 let mut src = Fixed {
                     dir: Some(ud),
                     lobe: Some(ul),
@@ -792,8 +823,8 @@ mod tests {
             for _ in 0..500 {
                 let wo = LVec3::<f64>::from_fn(|_| random_dir(&mut rng));
                 let (u0, u1) = (rng.next_f64(), rng.next_f64());
-                let a = lane.sample(wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
-                let b = lane.sample(wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
+                let a = sample_of(&lane, wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
+                let b = sample_of(&lane, wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
                 assert_eq!(a.ok, b.ok);
                 if a.ok {
                     assert_eq!(a.wi.lane(0), b.wi.lane(0));
@@ -819,8 +850,9 @@ mod tests {
                 let wo8 = LVec3::<F32x8>::from_fn(|i| wo[i]);
                 let wi8 = LVec3::<F32x8>::from_fn(|i| wi[i]);
                 let free8 = || Given(F32x8::from_fn(|i| u[i][3]), F32x8::from_fn(|i| u[i][4]));
-                let (v8, p8) = lane.eval_pdf(wo8, wi8, &mut free8());
-                let s8 = lane.sample(
+                let (v8, p8) = eval_pdf_of(&lane, wo8, wi8, &mut free8());
+                let s8 = sample_of(
+                    &lane,
                     wo8,
                     F32x8::from_fn(|i| u[i][0]),
                     F32x8::from_fn(|i| u[i][1]),
@@ -832,12 +864,13 @@ mod tests {
                     let f32_in = |x: f64| x as f32 as f64;
                     let free = || Given(f32_in(u[i][3]), f32_in(u[i][4]));
                     let (wo_i, wi_i) = (wo8.lane(i), wi8.lane(i));
-                    let (v, p) = lane.eval_pdf::<f64>(wo_i.into(), wi_i.into(), &mut free());
+                    let (v, p) = eval_pdf_of(&lane, wo_i.into(), wi_i.into(), &mut free());
                     // f32 arithmetic moves an ill-conditioned value by more than its rounding
                     // (grazing pairs, near-specular peaks, Fresnel at the critical angle,
                     // where 1 − F ∝ √(cos − cos_c)): compare where moving wi by 1e-6 moves
                     // the f64 value and density by less than 1e-4.
-                    let (vp, pp) = lane.eval_pdf::<f64>(
+                    let (vp, pp) = eval_pdf_of(
+                        &lane,
                         wo_i.into(),
                         (wi_i + Vec3::splat(1e-6)).normalize().into(),
                         &mut free(),
@@ -865,7 +898,8 @@ mod tests {
                             );
                         }
                     }
-                    let s = lane.sample::<f64>(
+                    let s = sample_of(
+                        &lane,
                         wo_i.into(),
                         f32_in(u[i][0]),
                         f32_in(u[i][1]),
