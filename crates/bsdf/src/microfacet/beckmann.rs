@@ -207,7 +207,7 @@ impl Beckmann {
     }
 
     /// Visible normals over lanes, the one source of [`Distribution::sample_visible`]: stretch
-    /// the view to unit roughness, sample slopes ([`visible_slopes_unit_lanes`]), rotate and
+    /// the view to unit roughness, sample slopes (`visible_slopes_unit_lanes`), rotate and
     /// unstretch [Heitz & d'Eon 2014]. The stretched view (α_x v_x, α_y v_y, v_z) need not be
     /// normalized: the slope sampler only needs cos θ/(cos θ + sin θ) = z/(z + r).
     #[inline(always)]

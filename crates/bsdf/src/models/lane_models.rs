@@ -260,6 +260,10 @@ impl LaneBsdf {
 
     /// The value f(wo, wi) (no cosine) and the density of sampling wi from wo; a stochastic
     /// model draws its further numbers from `rng`.
+    ///
+    /// `#[inline(always)]` so that it compiles with its caller's instruction set: a caller
+    /// that would inline it into a loop wraps it in a function of its own (the render
+    /// kernel's `model_calls`), or LLVM's loop passes take minutes on the result.
     #[inline(always)]
     pub fn eval_pdf<R: Real>(
         &self,
@@ -405,7 +409,8 @@ impl LaneBsdf {
 
     /// Samples wi from wo with the lobe number `u_lobe` and the direction numbers
     /// (`u0`, `u1`) — the numbers the f64 model takes from its source in that order — and,
-    /// for a stochastic model, further numbers from `rng`.
+    /// for a stochastic model, further numbers from `rng`. Inlined like
+    /// [`eval_pdf`](Self::eval_pdf), with the same caution for callers.
     #[inline(always)]
     pub fn sample<R: Real>(
         &self,
