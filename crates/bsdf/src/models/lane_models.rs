@@ -262,8 +262,10 @@ impl LaneBsdf {
     /// model draws its further numbers from `rng`.
     ///
     /// `#[inline(always)]` so that it compiles with its caller's instruction set: a caller
-    /// that would inline it into a loop wraps it in a function of its own (the render
-    /// kernel's `model_calls`), or LLVM's loop passes take minutes on the result.
+    /// in a loop calls it through a function of its own
+    /// ([`eval_pdf_out_of_line`](Self::eval_pdf_out_of_line), or one compiled for the
+    /// caller's features as the render kernel's `model_calls` does), or LLVM's loop passes
+    /// take minutes on the result.
     #[inline(always)]
     pub fn eval_pdf<R: Real>(
         &self,
@@ -505,6 +507,33 @@ impl LaneBsdf {
         }
     }
 
+    /// [`eval_pdf`](Self::eval_pdf) as a function of its own, for the lane type's baseline
+    /// instruction set: what a caller in a loop calls (the tests, the render kernel's f64
+    /// lanes and its fallback without AVX2).
+    #[inline(never)]
+    pub fn eval_pdf_out_of_line<R: Real>(
+        &self,
+        wo: LVec3<R>,
+        wi: LVec3<R>,
+        rng: &mut impl LaneRandom<R>,
+    ) -> ([R; 3], R) {
+        self.eval_pdf(wo, wi, rng)
+    }
+
+    /// [`sample`](Self::sample) as a function of its own, like
+    /// [`eval_pdf_out_of_line`](Self::eval_pdf_out_of_line).
+    #[inline(never)]
+    pub fn sample_out_of_line<R: Real>(
+        &self,
+        wo: LVec3<R>,
+        u_lobe: R,
+        u0: R,
+        u1: R,
+        rng: &mut impl LaneRandom<R>,
+    ) -> LaneSample<R> {
+        self.sample(wo, u_lobe, u0, u1, rng)
+    }
+
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn dielectric_sample<R: Real>(
@@ -616,31 +645,6 @@ mod tests {
         }
     }
 
-    /// The model calls out of line: inlined into these loops (every model, both
-    /// distributions), they make functions whose optimization grows faster than linearly
-    /// with their size and cost the test build minutes.
-    #[inline(never)]
-    fn eval_pdf_of<R: Real>(
-        lane: &LaneBsdf,
-        wo: LVec3<R>,
-        wi: LVec3<R>,
-        rng: &mut impl LaneRandom<R>,
-    ) -> ([R; 3], R) {
-        lane.eval_pdf(wo, wi, rng)
-    }
-
-    #[inline(never)]
-    fn sample_of<R: Real>(
-        lane: &LaneBsdf,
-        wo: LVec3<R>,
-        u_lobe: R,
-        u0: R,
-        u1: R,
-        rng: &mut impl LaneRandom<R>,
-    ) -> LaneSample<R> {
-        lane.sample(wo, u_lobe, u0, u1, rng)
-    }
-
     fn materials() -> Vec<toml::Table> {
         [
             r#"type = "lambert"
@@ -721,7 +725,8 @@ mod tests {
                 let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
                 // The stochastic IL body: both sides draw from equal streams.
                 let free = Pcg32::new(k, 11);
-                let (v, p) = eval_pdf_of(&lane, wo.into(), wi.into(), &mut FreeLanes(free.clone()));
+                let (v, p) =
+                    lane.eval_pdf_out_of_line(wo.into(), wi.into(), &mut FreeLanes(free.clone()));
                 let want = model.eval(wo, wi, &ctx, &mut free.clone());
                 let want_pdf = model.pdf(wo, wi, &ctx);
                 for c in 0..3 {
@@ -750,8 +755,7 @@ mod tests {
                 let wo = random_dir(&mut rng);
                 let (ul, ud) = (rng.next_f64(), rng.next_2d());
                 let free = Pcg32::new(k, 12);
-                let s = sample_of(
-                    &lane,
+                let s = lane.sample_out_of_line(
                     wo.into(),
                     ul,
                     ud.x,
@@ -828,8 +832,8 @@ mod tests {
             for _ in 0..500 {
                 let wo = LVec3::<f64>::from_fn(|_| random_dir(&mut rng));
                 let (u0, u1) = (rng.next_f64(), rng.next_f64());
-                let a = sample_of(&lane, wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
-                let b = sample_of(&lane, wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
+                let a = lane.sample_out_of_line(wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
+                let b = lane.sample_out_of_line(wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
                 assert_eq!(a.ok, b.ok);
                 if a.ok {
                     assert_eq!(a.wi.lane(0), b.wi.lane(0));
@@ -855,9 +859,8 @@ mod tests {
                 let wo8 = LVec3::<F32x8>::from_fn(|i| wo[i]);
                 let wi8 = LVec3::<F32x8>::from_fn(|i| wi[i]);
                 let free8 = || Given(F32x8::from_fn(|i| u[i][3]), F32x8::from_fn(|i| u[i][4]));
-                let (v8, p8) = eval_pdf_of(&lane, wo8, wi8, &mut free8());
-                let s8 = sample_of(
-                    &lane,
+                let (v8, p8) = lane.eval_pdf_out_of_line(wo8, wi8, &mut free8());
+                let s8 = lane.sample_out_of_line(
                     wo8,
                     F32x8::from_fn(|i| u[i][0]),
                     F32x8::from_fn(|i| u[i][1]),
@@ -869,13 +872,12 @@ mod tests {
                     let f32_in = |x: f64| x as f32 as f64;
                     let free = || Given(f32_in(u[i][3]), f32_in(u[i][4]));
                     let (wo_i, wi_i) = (wo8.lane(i), wi8.lane(i));
-                    let (v, p) = eval_pdf_of(&lane, wo_i.into(), wi_i.into(), &mut free());
+                    let (v, p) = lane.eval_pdf_out_of_line(wo_i.into(), wi_i.into(), &mut free());
                     // f32 arithmetic moves an ill-conditioned value by more than its rounding
                     // (grazing pairs, near-specular peaks, Fresnel at the critical angle,
                     // where 1 − F ∝ √(cos − cos_c)): compare where moving wi by 1e-6 moves
                     // the f64 value and density by less than 1e-4.
-                    let (vp, pp) = eval_pdf_of(
-                        &lane,
+                    let (vp, pp) = lane.eval_pdf_out_of_line(
                         wo_i.into(),
                         (wi_i + Vec3::splat(1e-6)).normalize().into(),
                         &mut free(),
@@ -903,8 +905,7 @@ mod tests {
                             );
                         }
                     }
-                    let s = sample_of(
-                        &lane,
+                    let s = lane.sample_out_of_line(
                         wo_i.into(),
                         f32_in(u[i][0]),
                         f32_in(u[i][1]),

@@ -12,51 +12,10 @@
 use facette_bsdf::lanes::{F32x8, F64x8, LVec3, Real};
 use facette_bsdf::models::{LaneBsdf, LaneRandom, LaneSample};
 
-/// A lane type the kernel shades with, and how it calls the lane models.
+/// A lane type the kernel shades with, and how it calls the lane models: by default their
+/// baseline out-of-line functions.
 pub(crate) trait ShadingLanes: Real {
     /// [`LaneBsdf::eval_pdf`], out of line.
-    fn eval_pdf(
-        model: &LaneBsdf,
-        wo: LVec3<Self>,
-        wi: LVec3<Self>,
-        rng: &mut impl LaneRandom<Self>,
-    ) -> ([Self; 3], Self);
-
-    /// [`LaneBsdf::sample`], out of line.
-    fn sample(
-        model: &LaneBsdf,
-        wo: LVec3<Self>,
-        u_lobe: Self,
-        u0: Self,
-        u1: Self,
-        rng: &mut impl LaneRandom<Self>,
-    ) -> LaneSample<Self>;
-}
-
-#[inline(never)]
-fn eval_pdf_portable<S: Real>(
-    model: &LaneBsdf,
-    wo: LVec3<S>,
-    wi: LVec3<S>,
-    rng: &mut impl LaneRandom<S>,
-) -> ([S; 3], S) {
-    model.eval_pdf(wo, wi, rng)
-}
-
-#[inline(never)]
-fn sample_portable<S: Real>(
-    model: &LaneBsdf,
-    wo: LVec3<S>,
-    u_lobe: S,
-    u0: S,
-    u1: S,
-    rng: &mut impl LaneRandom<S>,
-) -> LaneSample<S> {
-    model.sample(wo, u_lobe, u0, u1, rng)
-}
-
-/// f64 lanes (the test that finds the scalar integrator's image): the baseline build.
-impl ShadingLanes for F64x8 {
     #[inline(always)]
     fn eval_pdf(
         model: &LaneBsdf,
@@ -64,9 +23,10 @@ impl ShadingLanes for F64x8 {
         wi: LVec3<Self>,
         rng: &mut impl LaneRandom<Self>,
     ) -> ([Self; 3], Self) {
-        eval_pdf_portable(model, wo, wi, rng)
+        model.eval_pdf_out_of_line(wo, wi, rng)
     }
 
+    /// [`LaneBsdf::sample`], out of line.
     #[inline(always)]
     fn sample(
         model: &LaneBsdf,
@@ -76,9 +36,12 @@ impl ShadingLanes for F64x8 {
         u1: Self,
         rng: &mut impl LaneRandom<Self>,
     ) -> LaneSample<Self> {
-        sample_portable(model, wo, u_lobe, u0, u1, rng)
+        model.sample_out_of_line(wo, u_lobe, u0, u1, rng)
     }
 }
+
+/// f64 lanes (the test that finds the scalar integrator's image): the baseline build.
+impl ShadingLanes for F64x8 {}
 
 /// f32 lanes (renders): the AVX2 + FMA build where the CPU has them (the feature test is
 /// a cached flag), the baseline build elsewhere.
@@ -95,7 +58,7 @@ impl ShadingLanes for F32x8 {
             // SAFETY: the CPU has the features the function is compiled for.
             return unsafe { eval_pdf_avx2(model, wo, wi, rng) };
         }
-        eval_pdf_portable(model, wo, wi, rng)
+        model.eval_pdf_out_of_line(wo, wi, rng)
     }
 
     #[inline(always)]
@@ -112,7 +75,7 @@ impl ShadingLanes for F32x8 {
             // SAFETY: the CPU has the features the function is compiled for.
             return unsafe { sample_avx2(model, wo, u_lobe, u0, u1, rng) };
         }
-        sample_portable(model, wo, u_lobe, u0, u1, rng)
+        model.sample_out_of_line(wo, u_lobe, u0, u1, rng)
     }
 }
 

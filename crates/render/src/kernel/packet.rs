@@ -55,22 +55,22 @@ type Lanes = u8;
 type G = F64x8;
 
 #[inline(always)]
-fn to_s<S: ShadingLanes>(x: G) -> S {
+fn to_s<S: Real>(x: G) -> S {
     S::from_fn(|i| x.0[i])
 }
 
 #[inline(always)]
-fn to_g<S: ShadingLanes>(x: S) -> G {
+fn to_g<S: Real>(x: S) -> G {
     F64x8(std::array::from_fn(|i| x.lane(i)))
 }
 
 #[inline(always)]
-fn vec_s<S: ShadingLanes>(v: LVec3<G>) -> LVec3<S> {
+fn vec_s<S: Real>(v: LVec3<G>) -> LVec3<S> {
     LVec3::new(to_s(v.x), to_s(v.y), to_s(v.z))
 }
 
 #[inline(always)]
-fn vec_g<S: ShadingLanes>(v: LVec3<S>) -> LVec3<G> {
+fn vec_g<S: Real>(v: LVec3<S>) -> LVec3<G> {
     LVec3::new(to_g(v.x), to_g(v.y), to_g(v.z))
 }
 
@@ -96,18 +96,18 @@ fn merge<R: Real>(set: Lanes, v: R, keep: R) -> R {
 type Rgb<S> = [S; 3];
 
 #[inline(always)]
-fn rgb_splat<S: ShadingLanes>(c: Spectrum) -> Rgb<S> {
+fn rgb_splat<S: Real>(c: Spectrum) -> Rgb<S> {
     std::array::from_fn(|k| S::splat(c[k]))
 }
 
 #[inline(always)]
-fn rgb_lane<S: ShadingLanes>(c: &Rgb<S>, i: usize) -> Spectrum {
+fn rgb_lane<S: Real>(c: &Rgb<S>, i: usize) -> Spectrum {
     Spectrum([c[0].lane(i), c[1].lane(i), c[2].lane(i)])
 }
 
 /// Sets lane `i` of a spectrum to `v`.
 #[inline(always)]
-fn rgb_set<S: ShadingLanes>(c: &mut Rgb<S>, i: usize, v: Spectrum) {
+fn rgb_set<S: Real>(c: &mut Rgb<S>, i: usize, v: Spectrum) {
     for k in 0..3 {
         let old = c[k];
         c[k] = S::from_fn(|j| if j == i { v[k] } else { old.lane(j) });
@@ -307,12 +307,7 @@ enum VertexBsdf<'s> {
 impl Kernel<'_> {
     /// Fills the empty lanes with camera rays, making a new batch when the last is used up.
     #[inline(always)]
-    fn refill<S: ShadingLanes>(
-        &self,
-        paths: &mut Paths<S>,
-        batch: &mut CameraBatch,
-        jobs: &mut Jobs,
-    ) {
+    fn refill<S: Real>(&self, paths: &mut Paths<S>, batch: &mut CameraBatch, jobs: &mut Jobs) {
         let mut filled: Lanes = 0;
         for i in 0..LANES {
             if paths.live & (1 << i) != 0 {
@@ -357,7 +352,7 @@ impl Kernel<'_> {
 
     /// The camera rays of the next (up to) eight jobs; `false` when no job is left.
     #[inline(always)]
-    fn make_batch<S: ShadingLanes>(&self, batch: &mut CameraBatch, jobs: &mut Jobs) -> bool {
+    fn make_batch<S: Real>(&self, batch: &mut CameraBatch, jobs: &mut Jobs) -> bool {
         let mut px = [0.0; LANES];
         let mut py = [0.0; LANES];
         let mut n = 0;
@@ -420,7 +415,7 @@ impl Kernel<'_> {
     /// MIS weight of emission found by the BSDF sample of the previous vertex, whose
     /// density was `prev_pdf`, against light sampling's density `pl`.
     #[inline(always)]
-    fn emission_weight<S: ShadingLanes>(&self, delta_prev: Lanes, prev_pdf: S, pl: S) -> S {
+    fn emission_weight<S: Real>(&self, delta_prev: Lanes, prev_pdf: S, pl: S) -> S {
         let w = match self.strategy {
             Strategy::Mis => power_heuristic_lanes(prev_pdf, pl),
             Strategy::NeeOnly => S::zero(),
@@ -431,7 +426,7 @@ impl Kernel<'_> {
 
     /// Adds `beta · le · w` to the lanes of `set`.
     #[inline(always)]
-    fn add_radiance<S: ShadingLanes>(paths: &mut Paths<S>, set: Lanes, le: &Rgb<S>, w: S) {
+    fn add_radiance<S: Real>(paths: &mut Paths<S>, set: Lanes, le: &Rgb<S>, w: S) {
         for ((l, beta), le) in paths.l.iter_mut().zip(&paths.beta).zip(le) {
             *l = merge(set, *l + *beta * *le * w, *l);
         }
@@ -439,7 +434,7 @@ impl Kernel<'_> {
 
     /// Ends the paths of `set`: their radiance goes to their pixels.
     #[inline(always)]
-    fn finish<S: ShadingLanes>(paths: &mut Paths<S>, set: Lanes, sums: &mut [PixelSums]) {
+    fn finish<S: Real>(paths: &mut Paths<S>, set: Lanes, sums: &mut [PixelSums]) {
         for i in lanes_of(set) {
             sums[paths.slot[i] as usize].add(rgb_lane(&paths.l, i));
         }
@@ -524,7 +519,7 @@ impl Kernel<'_> {
 
     /// Emission seen by the rays of `missed` leaving the scene.
     #[inline(always)]
-    fn environment<S: ShadingLanes>(&self, paths: &mut Paths<S>, missed: Lanes) {
+    fn environment<S: Real>(&self, paths: &mut Paths<S>, missed: Lanes) {
         let scene = self.scene;
         let Some(env) = scene.environment else { return };
         let Light::Environment(e) = &scene.lights[env as usize] else {
@@ -565,7 +560,7 @@ impl Kernel<'_> {
 
     /// Emission of the area lights the hits of `hl` lie on.
     #[inline(always)]
-    fn area_emission<S: ShadingLanes>(&self, paths: &mut Paths<S>, hl: &HitLanes) {
+    fn area_emission<S: Real>(&self, paths: &mut Paths<S>, hl: &HitLanes) {
         let scene = self.scene;
         for i in lanes_of(hl.lanes & paths.live) {
             let Some(li) = scene.shape_light[hl.shape[i] as usize] else {
@@ -1005,7 +1000,7 @@ fn constant_pdf(c: &ConstantEnvironment) -> f64 {
 
 /// [`power_heuristic`] over lanes.
 #[inline(always)]
-fn power_heuristic_lanes<S: ShadingLanes>(a: S, b: S) -> S {
+fn power_heuristic_lanes<S: Real>(a: S, b: S) -> S {
     let (a2, b2) = (a * a, b * b);
     let sum = a2 + b2;
     S::select(sum.eq(S::zero()), S::zero(), a2 / sum)
