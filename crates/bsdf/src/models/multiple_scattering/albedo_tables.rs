@@ -567,7 +567,7 @@ impl AlbedoTable {
 
     /// (row, fraction toward the next row) for α.
     #[inline]
-    fn row_of(alpha: f64) -> (usize, f64) {
+    pub(super) fn row_of(alpha: f64) -> (usize, f64) {
         let s = (alpha / (1.0 + alpha)).clamp(0.0, S_MAX);
         let x = (s / S_MAX).powf(1.0 / ROW_EXPONENT) * (ALPHA_NODES - 1) as f64;
         let j = (x as usize).min(ALPHA_NODES - 2);
@@ -683,6 +683,11 @@ impl AlbedoTable {
     /// E at row j, column k (the tabulated value).
     pub fn entry(&self, j: usize, k: usize) -> f64 {
         self.e[j * MU_NODES + k]
+    }
+
+    /// ∫ (1 − E) μ dμ of row j from μ = 0 to the end of interval k.
+    pub(super) fn cumulative_mass(&self, j: usize, k: usize) -> f64 {
+        self.cumulative[j * (MU_NODES - 1) + k]
     }
 
     /// "ggx, masking smith-correlated, dielectric η = 1.5".

@@ -17,8 +17,15 @@
 //!
 //! **Sampling.** With probability E(μ_o) the single-scattering lobe's sampler; otherwise the
 //! compensation lobe's exact sampler (density (1 − E(μ_i)) μ_i / (π (1 − E_avg))). The pdf
-//! is the exact mixture and the weight eval·cos/pdf.
+//! is the exact mixture and the weight eval·cos/pdf; a direction drawn from the lobe reuses
+//! the lobe's own density and value instead of evaluating them again.
+//!
+//! **Cost.** E is read from the table's row at the material's α ([`AlbedoRow`]), blended
+//! once when the material is built: a lookup is a square root and a multiply–add, so the
+//! compensated model costs the single-scattering lobe plus two lookups (issue 16 point 7
+//! asks ≤ 1.3× the lobe's cost; measured in docs/performance.md).
 
+use super::albedo_row::AlbedoRow;
 use super::albedo_tables::{table_alpha, AlbedoTable, TableFresnel};
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::error::{ParamError, ParamResult};
@@ -36,7 +43,8 @@ use std::sync::Arc;
 pub struct CompensatedConductor {
     single: RoughConductor,
     table: Arc<AlbedoTable>,
-    alpha: f64,
+    /// The table's row at the lobe's α.
+    row: AlbedoRow,
     /// F_ms / (π (1 − E_avg)) per channel: the compensation lobe is this times
     /// (1 − E(μ_o)) (1 − E(μ_i)).
     scale: Spectrum,
@@ -72,8 +80,8 @@ impl CompensatedConductor {
         };
         Ok(CompensatedConductor {
             single,
+            row: table.row_at(alpha),
             table,
-            alpha,
             scale,
         })
     }
@@ -90,21 +98,27 @@ impl CompensatedConductor {
         self.single.lobe().expect("checked in new")
     }
 
-    /// The compensation lobe for an upper-hemisphere pair.
+    /// The compensation lobe for an upper-hemisphere pair, from 1 − E of each side.
     #[inline]
-    fn compensation(&self, o: Vec3, i: Vec3) -> Spectrum {
-        let eo = self.table.albedo(o.z, self.alpha);
-        let ei = self.table.albedo(i.z, self.alpha);
-        self.scale * ((1.0 - eo).max(0.0) * (1.0 - ei).max(0.0))
+    fn compensation(&self, missing_o: f64, i: Vec3) -> Spectrum {
+        self.scale * (missing_o * self.row.missing(i.z))
     }
 
-    /// Probability of drawing from the single-scattering lobe: E(μ_o).
+    /// Probability of drawing from the single-scattering lobe, E(μ_o), and 1 − E(μ_o) (at
+    /// least 0).
     #[inline]
-    fn single_share(&self, o: Vec3) -> f64 {
+    fn single_share(&self, o: Vec3) -> (f64, f64) {
         if self.scale.is_black() {
-            return 1.0;
+            return (1.0, 0.0);
         }
-        self.table.albedo(o.z, self.alpha).clamp(0.0, 1.0)
+        let e = self.row.albedo(o.z);
+        (e.clamp(0.0, 1.0), (1.0 - e).max(0.0))
+    }
+
+    /// The mixture density from the lobe's density `lobe_pdf` of the pair.
+    #[inline]
+    fn mixture_pdf(&self, share: f64, lobe_pdf: f64, i: Vec3) -> f64 {
+        share * lobe_pdf + (1.0 - share) * self.row.lobe_density(i.z)
     }
 }
 
@@ -114,7 +128,8 @@ impl OpaqueBsdf for CompensatedConductor {
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
-        self.single.eval(wo, wi, ctx, rng) + self.compensation(wo, wi)
+        let missing_o = self.single_share(wo).1;
+        self.single.eval(wo, wi, ctx, rng) + self.compensation(missing_o, wi)
     }
 
     fn sample(
@@ -124,28 +139,36 @@ impl OpaqueBsdf for CompensatedConductor {
         rng: &mut dyn RandomSource,
     ) -> Option<BsdfSample> {
         let o = wo;
-        let (i, lobe) = if rng.next_f64() < self.single_share(o) {
-            (
-                self.lobe().sample(o, rng.next_2d())?.0,
-                LobeFlags::GLOSSY_REFLECTION,
-            )
+        let (share, missing_o) = self.single_share(o);
+        // The lobe's value f_ss and density of the drawn pair.
+        let (i, f_ss, lobe_pdf, lobe) = if rng.next_f64() < share {
+            let lobe = self.lobe();
+            let (i, _, lobe_pdf) = lobe.sample(o, rng.next_2d())?;
+            let f_ss = self.single.tint() * lobe.eval(o, i, |c| self.single.fresnel().eval(c));
+            (i, f_ss, lobe_pdf, LobeFlags::GLOSSY_REFLECTION)
         } else {
-            let mu = self.table.sample_mu(self.alpha, rng)?;
+            let mu = self.row.sample_mu(rng)?;
             let r = (1.0 - mu * mu).max(0.0).sqrt();
             let (s, c) = (TWO_PI * rng.next_f64()).sin_cos();
-            (Vec3::new(r * c, r * s, mu), LobeFlags::DIFFUSE_REFLECTION)
+            let i = Vec3::new(r * c, r * s, mu);
+            let f_ss = self.single.eval(o, i, ctx, rng);
+            (
+                i,
+                f_ss,
+                self.lobe().pdf(o, i),
+                LobeFlags::DIFFUSE_REFLECTION,
+            )
         };
         if i.z <= 0.0 {
             return None;
         }
-        let wi = i;
-        let pdf = self.pdf(wo, wi, ctx);
+        let pdf = self.mixture_pdf(share, lobe_pdf, i);
         if !(pdf > 0.0) {
             return None;
         }
-        let weight = self.eval(wo, wi, ctx, rng) * (i.z / pdf);
+        let weight = (f_ss + self.compensation(missing_o, i)) * (i.z / pdf);
         weight.is_finite().then_some(BsdfSample {
-            wi,
+            wi: i,
             weight,
             pdf,
             lobe,
@@ -155,8 +178,8 @@ impl OpaqueBsdf for CompensatedConductor {
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
         let (o, i) = (wo, wi);
-        let ps = self.single_share(o);
-        let p = ps * self.lobe().pdf(o, i) + (1.0 - ps) * self.table.lobe_density(i.z, self.alpha);
+        let (share, _) = self.single_share(o);
+        let p = self.mixture_pdf(share, self.lobe().pdf(o, i), i);
         guard(p, || {
             format!("{} pdf(wo = {wo:?}, wi = {wi:?})", self.describe())
         })

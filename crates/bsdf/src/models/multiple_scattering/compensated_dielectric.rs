@@ -58,8 +58,14 @@
 //! reflection with probability s_A(μ_o) or transmission, with μ drawn from the density
 //! ∝ (1 − E(μ)) μ of the side it lands on (the tables' exact sampler; it covers the lobes,
 //! whose shapes are a_A, u_B ≤ 1 − E). The pdf is the exact mixture, the weight
-//! eval·|cos|/pdf.
+//! eval·|cos|/pdf; a direction drawn by WMLT07's sampler reuses its value and density.
+//!
+//! **Cost.** E and the shares are read from their blends at the material's α, made once when
+//! it is built ([`AlbedoRow`], [`SquareNodes`]): a lookup is a square root and a
+//! multiply–add, so the model costs WMLT07's plus three or four lookups (issue 16 point 7
+//! asks ≤ 1.3×; measured in docs/performance.md).
 
+use super::albedo_row::{AlbedoRow, SquareNodes};
 use super::albedo_tables::{
     kind_of_table, row_alpha, row_weight, table_alpha, AlbedoTable, TableFresnel, ALPHA_NODES,
 };
@@ -92,7 +98,8 @@ fn share_node(k: usize) -> f64 {
     x * x
 }
 
-/// Linear interpolation of node values at μ.
+/// Linear interpolation of node values at μ (for the builders; the per-call lookups use
+/// the material's [`SquareNodes`]).
 #[inline]
 fn interpolate(values: &[f64; SHARE_NODES], mu: f64) -> f64 {
     let x = mu.clamp(0.0, 1.0).sqrt() * (SHARE_NODES - 1) as f64;
@@ -114,8 +121,11 @@ struct Shares {
 #[derive(Clone, Debug)]
 struct Side {
     table: Arc<AlbedoTable>,
-    /// c_A: the factor on 1 − s that makes the averages reciprocal between table rows.
-    scale: f64,
+    /// The table's row at the material's α.
+    row: AlbedoRow,
+    /// s_A(μ) at the material's α with c_A applied: 1 − c_A (1 − s), c_A the factor on
+    /// 1 − s that makes the averages reciprocal between table rows.
+    share: SquareNodes<SHARE_NODES>,
     /// ā_A and ū_A: the averages of the compensation's reflectance and transmittance.
     reflected: f64,
     transmitted: f64,
@@ -124,10 +134,6 @@ struct Side {
 #[derive(Clone, Debug)]
 pub struct CompensatedDielectric {
     single: RoughDielectric,
-    alpha: f64,
-    /// The shares at the table rows around α, and the fraction t toward the second.
-    rows: (Arc<Shares>, Arc<Shares>),
-    t: f64,
     outside: Side,
     inside: Side,
     reflect_tint: Spectrum,
@@ -360,22 +366,24 @@ impl CompensatedDielectric {
             (1.0, 1.0)
         };
         let (tints_r, tints_t) = single.tints();
-        let side = |table: Arc<AlbedoTable>, scale: f64, u: f64| {
+        let side = |table: Arc<AlbedoTable>, scale: f64, u: f64, a: &[f64; SHARE_NODES], b| {
             let transmitted = scale * u;
             let reflected = ((1.0 - table.average(alpha)) - transmitted).max(0.0);
+            let shares: &[f64; SHARE_NODES] = b;
+            let share = SquareNodes::new(std::array::from_fn(|k| {
+                1.0 - scale * (1.0 - ((1.0 - t) * a[k] + t * shares[k]))
+            }));
             Side {
+                row: table.row_at(alpha),
                 table,
-                scale,
+                share,
                 reflected,
                 transmitted,
             }
         };
         Ok(CompensatedDielectric {
-            alpha,
-            rows,
-            t,
-            outside: side(out_t, c_out, u_out),
-            inside: side(in_t, c_in, u_in),
+            outside: side(out_t, c_out, u_out, &rows.0.outside, &rows.1.outside),
+            inside: side(in_t, c_in, u_in, &rows.0.inside, &rows.1.inside),
             reflect_tint: tints_r,
             transmit_tint: tints_t,
             single,
@@ -398,16 +406,9 @@ impl CompensatedDielectric {
     }
 
     /// s_A(μ) for light from the side of `w`: the share of its missing energy reflected.
+    #[inline]
     pub fn reflected_share(&self, w: Vec3) -> f64 {
-        let mu = w.z.abs();
-        let (a, b) = (&self.rows.0, &self.rows.1);
-        let (sa, sb) = if w.z > 0.0 {
-            (&a.outside, &b.outside)
-        } else {
-            (&a.inside, &b.inside)
-        };
-        let s = (1.0 - self.t) * interpolate(sa, mu) + self.t * interpolate(sb, mu);
-        1.0 - self.side(w).scale * (1.0 - s)
+        self.side(w).share.at(w.z.abs())
     }
 
     #[inline]
@@ -422,7 +423,7 @@ impl CompensatedDielectric {
     /// 1 − E_side(μ) for a direction on that side.
     #[inline]
     fn missing(&self, w: Vec3) -> f64 {
-        (1.0 - self.side(w).table.albedo(w.z.abs(), self.alpha)).max(0.0)
+        self.side(w).row.missing(w.z.abs())
     }
 
     /// a(μ) and u(μ) of the side of `w`.
@@ -434,6 +435,7 @@ impl CompensatedDielectric {
     }
 
     /// The compensation lobes, f(i, o) with i the light direction [KC17 §5].
+    #[inline]
     fn compensation(&self, i: Vec3, o: Vec3) -> Spectrum {
         let (ai, ui) = self.reflected_and_transmitted(i);
         let (ao, uo) = self.reflected_and_transmitted(o);
@@ -451,10 +453,32 @@ impl CompensatedDielectric {
         }
     }
 
+    /// The compensation lobes for the pair (wo, wi) in the transport mode of `ctx`.
+    #[inline]
+    fn compensation_of(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> Spectrum {
+        match ctx.mode {
+            TransportMode::Radiance => self.compensation(wi, wo),
+            TransportMode::Importance => self.compensation(wo, wi),
+        }
+    }
+
     /// Probability of drawing from WMLT07's sampler: E of the view's side.
     #[inline]
     fn single_share(&self, wo: Vec3) -> f64 {
         1.0 - self.missing(wo)
+    }
+
+    /// The mixture density of the pair from WMLT07's density `single_pdf` of it.
+    #[inline]
+    fn mixture_pdf(&self, wo: Vec3, wi: Vec3, single_pdf: f64) -> f64 {
+        let ps = self.single_share(wo);
+        let s = self.reflected_share(wo);
+        let lobe = if wi.z * wo.z > 0.0 {
+            s * self.side(wo).row.lobe_density(wi.z.abs())
+        } else {
+            (1.0 - s) * self.side(wi).row.lobe_density(wi.z.abs())
+        };
+        ps * single_pdf + (1.0 - ps) * lobe
     }
 }
 
@@ -470,11 +494,7 @@ impl Bsdf for CompensatedDielectric {
         if wo.z == 0.0 || wi.z == 0.0 {
             return Spectrum::ZERO;
         }
-        let (i, o) = match ctx.mode {
-            TransportMode::Radiance => (wi, wo),
-            TransportMode::Importance => (wo, wi),
-        };
-        let v = self.single.eval(wo, wi, ctx, rng) + self.compensation(i, o);
+        let v = self.single.eval(wo, wi, ctx, rng) + self.compensation_of(wo, wi, ctx);
         guard(v, || {
             format!(
                 "{} eval(wo = {wo:?}, wi = {wi:?}, {:?})",
@@ -493,9 +513,10 @@ impl Bsdf for CompensatedDielectric {
         if wo.z == 0.0 {
             return None;
         }
-        let (wi, lobe) = if rng.next_f64() < self.single_share(wo) {
+        // The direction, WMLT07's f·|cos θ_i| and density for it, and the lobe drawn.
+        let (wi, f_ss_cos, single_pdf, lobe) = if rng.next_f64() < self.single_share(wo) {
             let s = self.single.sample(wo, ctx, rng)?;
-            (s.wi, s.lobe)
+            (s.wi, s.weight * s.pdf, s.pdf, s.lobe)
         } else {
             let here = self.side(wo);
             let reflect = rng.next_f64() < self.reflected_share(wo);
@@ -504,7 +525,7 @@ impl Bsdf for CompensatedDielectric {
                 (false, true) => &self.inside,
                 (false, false) => &self.outside,
             };
-            let mu = there.table.sample_mu(self.alpha, rng)?;
+            let mu = there.row.sample_mu(rng)?;
             let r = (1.0 - mu * mu).max(0.0).sqrt();
             let (s, c) = (TWO_PI * rng.next_f64()).sin_cos();
             let z = if (wo.z > 0.0) == reflect { mu } else { -mu };
@@ -513,16 +534,21 @@ impl Bsdf for CompensatedDielectric {
             } else {
                 LobeFlags::DIFFUSE_TRANSMISSION
             };
-            (Vec3::new(r * c, r * s, z), lobe)
+            let wi = Vec3::new(r * c, r * s, z);
+            if wi.z == 0.0 {
+                return None;
+            }
+            let f = self.single.eval(wo, wi, ctx, rng) * wi.z.abs();
+            (wi, f, self.single.pdf(wo, wi, ctx), lobe)
         };
         if wi.z == 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi, ctx);
+        let pdf = self.mixture_pdf(wo, wi, single_pdf);
         if !(pdf > 0.0) {
             return None;
         }
-        let weight = self.eval(wo, wi, ctx, rng) * (wi.z.abs() / pdf);
+        let weight = (f_ss_cos + self.compensation_of(wo, wi, ctx) * wi.z.abs()) * (1.0 / pdf);
         let transmitted = wi.z * wo.z < 0.0;
         let eta = match (transmitted, wo.z > 0.0) {
             (false, _) => 1.0,
@@ -542,15 +568,7 @@ impl Bsdf for CompensatedDielectric {
         if wo.z == 0.0 || wi.z == 0.0 {
             return 0.0;
         }
-        let ps = self.single_share(wo);
-        let here = self.side(wo);
-        let s = self.reflected_share(wo);
-        let lobe = if wi.z * wo.z > 0.0 {
-            s * here.table.lobe_density(wi.z.abs(), self.alpha)
-        } else {
-            (1.0 - s) * self.side(wi).table.lobe_density(wi.z.abs(), self.alpha)
-        };
-        let p = ps * self.single.pdf(wo, wi, ctx) + (1.0 - ps) * lobe;
+        let p = self.mixture_pdf(wo, wi, self.single.pdf(wo, wi, ctx));
         guard(p, || {
             format!("{} pdf(wo = {wo:?}, wi = {wi:?})", self.describe())
         })
