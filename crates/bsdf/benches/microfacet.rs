@@ -158,9 +158,39 @@ fn lane_kernels(c: &mut Criterion) {
     g.finish();
 }
 
+/// sin and cos of the samplers' angles 2πu: the C library's `sincos` against the one the
+/// lane code's f64 instantiation uses (`math::sin_cos`), in the same run.
+fn sin_cos(c: &mut Criterion) {
+    let (_, us) = inputs();
+    let angles: Vec<f64> = us.iter().map(|u| std::f64::consts::TAU * u.x).collect();
+    let mut g = c.benchmark_group("sin_cos");
+    g.throughput(Throughput::Elements(256));
+    g.bench_function("libm", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &x in black_box(&angles).iter() {
+                let (s, c) = x.sin_cos();
+                acc += s + c;
+            }
+            black_box(acc)
+        })
+    });
+    g.bench_function("facette", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &x in black_box(&angles).iter() {
+                let (s, c) = facette_bsdf::math::sin_cos::sin_cos(x);
+                acc += s + c;
+            }
+            black_box(acc)
+        })
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(std::time::Duration::from_millis(300)).measurement_time(std::time::Duration::from_secs(1));
-    targets = distributions, lane_kernels
+    targets = distributions, lane_kernels, sin_cos
 }
 criterion_main!(benches);

@@ -30,7 +30,7 @@ array_lanes!(
     {
         #[inline(always)]
         fn sin_cos(self) -> (Self, Self) {
-            let sc = lanewise!(self.0, |a| a.sin_cos());
+            let sc = lanewise!(self.0, |a| crate::math::sin_cos::sin_cos(a));
             (F64x4(sc.map(|p| p.0)), F64x4(sc.map(|p| p.1)))
         }
         #[inline(always)]

@@ -128,7 +128,7 @@ pub trait Real:
 }
 
 macro_rules! scalar_real {
-    ($t:ty, $tiny:expr, $cells:ident) => {
+    ($t:ty, $tiny:expr, $cells:ident, $sin_cos:path) => {
         impl Real for $t {
             type Mask = bool;
             const LANES: usize = 1;
@@ -196,7 +196,7 @@ macro_rules! scalar_real {
             }
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
-                <$t>::sin_cos(self)
+                $sin_cos(self)
             }
             #[inline(always)]
             fn exp(self) -> Self {
@@ -224,5 +224,5 @@ macro_rules! scalar_real {
     };
 }
 
-scalar_real!(f64, 1e-300, f64_cells);
-scalar_real!(f32, 1e-30, f32_cells);
+scalar_real!(f64, 1e-300, f64_cells, crate::math::sin_cos::sin_cos);
+scalar_real!(f32, 1e-30, f32_cells, f32::sin_cos);

@@ -12,6 +12,7 @@ pub mod complex;
 pub(crate) mod cosine_lobe;
 pub mod quadrature;
 pub mod rng;
+pub mod sin_cos;
 pub mod special;
 pub mod spectrum;
 pub mod warp;
