@@ -87,11 +87,11 @@ pub fn radiance(
         let Some(mut hit) = hit else {
             if let Some(env) = scene.environment {
                 if let Light::Environment(e) = &scene.lights[env as usize] {
-                    let le = e.eval(ray.dir);
+                    let (le, pdf) = e.eval_pdf(ray.dir);
                     let w = match strategy {
                         _ if delta_prev => 1.0,
                         Strategy::Mis => {
-                            let pl = scene.selector.probability(env as usize) * e.pdf(ray.dir);
+                            let pl = scene.selector.probability(env as usize) * pdf;
                             power_heuristic(prev_pdf, pl)
                         }
                         Strategy::NeeOnly => 0.0,

@@ -34,6 +34,15 @@ impl Environment {
         }
     }
 
+    /// `(eval(d), pdf(d))`, for a map from one look-up of the direction's texel.
+    #[inline]
+    pub fn eval_pdf(&self, d: Vec3) -> (Spectrum, f64) {
+        match self {
+            Environment::Map(m) => m.eval_pdf(d),
+            Environment::Constant(c) => (c.eval(d), c.pdf(d)),
+        }
+    }
+
     /// (direction, radiance, solid-angle pdf).
     #[inline]
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, Spectrum, f64)> {

@@ -56,6 +56,7 @@ use glam::{DMat3, DVec2, DVec3};
 
 use super::distribution_2d::Distribution2D;
 use super::rgb_image::{to_spectrum, RgbImage};
+use facette_bsdf::math::sin_cos::sin_cos;
 
 const TWO_PI: f64 = 2.0 * PI;
 const INV_TWO_PI: f64 = 0.5 * FRAC_1_PI;
@@ -134,84 +135,144 @@ fn sample_linear(xi: f64, a: f64, b: f64) -> f64 {
     (xi * (a + b) / den).clamp(0.0, ONE_MINUS_EPS)
 }
 
-/// sin(x) / x.
-#[inline]
-fn sinc(x: f64) -> f64 {
-    if x == 0.0 {
-        1.0
-    } else {
-        x.sin() / x
-    }
-}
-
 /// ∫ τ sin(cτ) dτ over τ ∈ [−½, ½], by its Taylor series
 /// Σₖ (−1)ᵏ c^(2k+1) / ((2k+1)! (2k+3) 4^(k+1)) — the closed form cancels catastrophically
-/// for small c. For c ≤ π/2 (every patch: c = π Δv ≤ π/2) nine terms reach 1e-17 relative.
+/// for small c. For c ≤ π/2 (every patch: c = π Δv ≤ π/2) nine terms reach 1e-17 relative;
+/// the coefficients are the series' own, in Horner form.
 #[inline]
 fn odd_sin_moment(c: f64) -> f64 {
+    const A: [f64; 9] = [
+        0.083_333_333_333_333_33,
+        -0.002_083_333_333_333_333_3,
+        1.860_119_047_619_047_8e-5,
+        -8.611_662_257_495_591e-8,
+        2.446_494_959_515_792_7e-10,
+        -4.704_797_999_068_832e-13,
+        6.534_441_665_373_378e-16,
+        -6.863_909_312_366_994e-19,
+        5.644_662_263_459_699e-22,
+    ];
     let c2 = c * c;
-    let mut term = 0.25 * c;
-    let mut sum = 0.0;
-    for k in 0..9 {
-        let k2 = 2.0 * k as f64;
-        sum += term / (k2 + 3.0);
-        term *= -c2 / (4.0 * (k2 + 2.0) * (k2 + 3.0));
+    let mut p = A[8];
+    for &a in A[..8].iter().rev() {
+        p = p * c2 + a;
     }
-    sum
+    c * p
 }
 
-/// (∫₀¹ sin(a + c r) dr, ∫₀¹ r sin(a + c r) dr), about the midpoint m = a + c/2 so that
-/// neither cancels for small c: sin m · sinc(c/2) and half of it + cos m · ∫τ sin(cτ) dτ.
-#[inline]
-fn sin_moments(a: f64, c: f64) -> (f64, f64) {
-    let (sin_m, cos_m) = (a + 0.5 * c).sin_cos();
-    let p0 = sin_m * sinc(0.5 * c);
-    (p0, 0.5 * p0 + cos_m * odd_sin_moment(c))
+/// A patch row's density in t ∈ [0, 1]: ((1 − t) top + t bottom) sin(a + c t)
+/// (a, a + c ∈ [0, π]), with its closed-form CDF.
+#[derive(Clone, Copy, Debug)]
+struct PatchRow {
+    a: f64,
+    c: f64,
+    top: f64,
+    bottom: f64,
 }
 
-/// The mass on t ∈ [0, t₁] of (1 − t) top + t bottom, times sin(a + c t):
-/// top ∫₀^t₁ (1 − t) sin + bottom ∫₀^t₁ t sin, two non-negative terms.
+/// What [`PatchRow::at`] gives: the CDF at t₁, the density at t₁, and sin a (the density's
+/// sine at t = 0).
+struct RowPoint {
+    cdf: f64,
+    density: f64,
+    sin_start: f64,
+}
+
+impl PatchRow {
+    /// The mass on [0, t₁] and the density at t₁, from the moments about the midpoint
+    /// m = a + h, h = c t₁ / 2, so that neither cancels for small c:
+    /// ∫₀¹ sin(a + c t₁ r) dr = sin m · sinc h and ∫₀¹ r sin(a + c t₁ r) dr = half of it +
+    /// cos m · ∫ τ sin(c t₁ τ) dτ; top ∫₀^t₁ (1 − t) sin + bottom ∫₀^t₁ t sin are two
+    /// non-negative terms. One `sin_cos` of m and one of h give these and the sines at both
+    /// ends, sin(m ± h).
+    #[inline]
+    fn at(&self, t1: f64) -> RowPoint {
+        let h = 0.5 * self.c * t1;
+        let (sm, cm) = sin_cos(self.a + h);
+        let (sh, ch) = sin_cos(h);
+        let sinc = if h == 0.0 { 1.0 } else { sh / h };
+        let p0 = sm * sinc;
+        let p1 = 0.5 * p0 + cm * odd_sin_moment(self.c * t1);
+        let lo = (t1 * (p0 - t1 * p1)).max(0.0);
+        let hi = (t1 * t1 * p1).max(0.0);
+        let sin_end = (sm * ch + cm * sh).max(0.0);
+        RowPoint {
+            cdf: self.top * lo + self.bottom * hi,
+            density: ((1.0 - t1) * self.top + t1 * self.bottom) * sin_end,
+            sin_start: (sm * ch - cm * sh).max(0.0),
+        }
+    }
+
+    /// Draws t ∈ [0, 1) with the row's density: Newton's method on the closed-form CDF, kept
+    /// inside a shrinking bracket by bisection, started from the linear density through the
+    /// end values. Newton converges quadratically from there, so a step below 1e-10 leaves
+    /// an error far below f64's resolution of t and ends the iteration (usually after two
+    /// evaluations; one more would only confirm it).
+    fn sample(&self, xi: f64) -> f64 {
+        let end = self.at(1.0);
+        let total = end.cdf;
+        if !(total > 0.0) {
+            return xi;
+        }
+        let target = xi * total;
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let mut t = sample_linear(xi, self.top * end.sin_start, end.density);
+        for _ in 0..64 {
+            let point = self.at(t);
+            let f = point.cdf - target;
+            // At the CDF's rounding: the bracket's end there may be a hair past the root,
+            // where a Newton step would fall outside and only bisect.
+            if f.abs() <= 1e-14 * total {
+                break;
+            }
+            if f > 0.0 {
+                hi = t;
+            } else {
+                lo = t;
+            }
+            let newton = t - f / point.density;
+            let (next, bisected) = if newton > lo && newton < hi {
+                (newton, false)
+            } else {
+                (0.5 * (lo + hi), true)
+            };
+            let step = (next - t).abs();
+            t = next;
+            if (!bisected && step <= 1e-10) || hi - lo <= 1e-15 {
+                break;
+            }
+        }
+        t.clamp(0.0, ONE_MINUS_EPS)
+    }
+}
+
+/// The mass on t ∈ [0, t₁] of (1 − t) top + t bottom, times sin(a + c t).
 #[inline]
 fn patch_row_cdf(a: f64, c: f64, top: f64, bottom: f64, t1: f64) -> f64 {
-    let (p0, p1) = sin_moments(a, c * t1);
-    let lo = (t1 * (p0 - t1 * p1)).max(0.0);
-    let hi = (t1 * t1 * p1).max(0.0);
-    top * lo + bottom * hi
+    PatchRow { a, c, top, bottom }.at(t1).cdf
 }
 
-/// Draws t ∈ [0, 1) with density ∝ ((1 − t) top + t bottom) sin(a + c t) (a, a + c ∈ [0, π]):
-/// Newton's method on the closed-form CDF, kept inside a shrinking bracket by bisection,
-/// started from the linear density through the end values.
-fn sample_patch_row(xi: f64, a: f64, c: f64, top: f64, bottom: f64) -> f64 {
-    let total = patch_row_cdf(a, c, top, bottom, 1.0);
-    if !(total > 0.0) {
-        return xi;
+/// The four pixels around a point of the map (upper left, upper right, lower left, lower
+/// right) and the point's fractions between them.
+struct Taps {
+    texels: [[f32; 3]; 4],
+    fx: f64,
+    fy: f64,
+}
+
+impl Taps {
+    /// Bilinear interpolation of `f(pixel)`.
+    #[inline]
+    fn interpolate<T>(&self, f: impl Fn([f32; 3]) -> T) -> T
+    where
+        T: std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+    {
+        let [a, b, c, d] = self.texels;
+        let (fx, fy) = (self.fx, self.fy);
+        let top = f(a) * (1.0 - fx) + f(b) * fx;
+        let bottom = f(c) * (1.0 - fx) + f(d) * fx;
+        top * (1.0 - fy) + bottom * fy
     }
-    let target = xi * total;
-    let density = |t: f64| ((1.0 - t) * top + t * bottom) * (a + c * t).sin().max(0.0);
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    let mut t = sample_linear(xi, density(0.0), density(1.0));
-    for _ in 0..64 {
-        let f = patch_row_cdf(a, c, top, bottom, t) - target;
-        if f > 0.0 {
-            hi = t;
-        } else if f < 0.0 {
-            lo = t;
-        } else {
-            break;
-        }
-        let d = density(t);
-        let mut next = t - f / d;
-        if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
-        }
-        let step = (next - t).abs();
-        t = next;
-        if step <= 1e-15 || hi - lo <= 1e-15 {
-            break;
-        }
-    }
-    t.clamp(0.0, ONE_MINUS_EPS)
 }
 
 #[derive(Clone, Debug)]
@@ -374,13 +435,11 @@ impl EnvironmentMap {
         self.image.data()[y * self.image.width() + x]
     }
 
-    /// Bilinear interpolation of `f(pixel)` between pixel centres at `uv`, wrapping in u and
-    /// clamping at the poles — the one interpolation behind both `eval` and `pdf`.
+    /// The four texels around `uv` and their weights: bilinear interpolation between pixel
+    /// centres, wrapping in u and clamping at the poles — the one interpolation behind both
+    /// `eval` and `pdf`.
     #[inline]
-    fn bilinear<T>(&self, uv: DVec2, f: impl Fn([f32; 3]) -> T) -> T
-    where
-        T: std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
-    {
+    fn taps(&self, uv: DVec2) -> Taps {
         let (w, h) = (self.image.width(), self.image.height());
         let x = uv.x * w as f64 - 0.5;
         let y = uv.y * h as f64 - 0.5;
@@ -390,9 +449,16 @@ impl EnvironmentMap {
         let xb = if xa + 1 == w { 0 } else { xa + 1 };
         let ya = (y0 as i64).clamp(0, h as i64 - 1) as usize;
         let yb = (y0 as i64 + 1).clamp(0, h as i64 - 1) as usize;
-        let top = f(self.texel(xa, ya)) * (1.0 - fx) + f(self.texel(xb, ya)) * fx;
-        let bottom = f(self.texel(xa, yb)) * (1.0 - fx) + f(self.texel(xb, yb)) * fx;
-        top * (1.0 - fy) + bottom * fy
+        Taps {
+            texels: [
+                self.texel(xa, ya),
+                self.texel(xb, ya),
+                self.texel(xa, yb),
+                self.texel(xb, yb),
+            ],
+            fx,
+            fy,
+        }
     }
 
     /// Radiance arriving along world direction `d` (bilinear, times `scale`); black for a
@@ -403,7 +469,29 @@ impl EnvironmentMap {
 
     /// Radiance at texture coordinates `uv` ∈ [0, 1)² (bilinear, times `scale`).
     fn eval_uv(&self, uv: DVec2) -> Spectrum {
-        self.bilinear(uv, to_spectrum) * self.scale
+        self.radiance_of(&self.taps(uv))
+    }
+
+    #[inline]
+    fn radiance_of(&self, taps: &Taps) -> Spectrum {
+        taps.interpolate(to_spectrum) * self.scale
+    }
+
+    #[inline]
+    fn density_of(&self, taps: &Taps) -> f64 {
+        if self.inv_integral == 0.0 {
+            return 0.0;
+        }
+        taps.interpolate(luminance) * self.inv_integral
+    }
+
+    /// [`eval`](Self::eval) and [`pdf`](Self::pdf) of `d` together, from one look-up of its
+    /// texture coordinates (what a ray leaving the scene needs for its MIS weight).
+    pub fn eval_pdf(&self, d: DVec3) -> (Spectrum, f64) {
+        self.uv(d).map_or((Spectrum::ZERO, 0.0), |uv| {
+            let taps = self.taps(uv);
+            (self.radiance_of(&taps), self.density_of(&taps))
+        })
     }
 
     /// Density (per unit solid angle) with which [`EnvironmentMap::sample`] produces `d`.
@@ -414,10 +502,7 @@ impl EnvironmentMap {
     /// Y(uv) / ∫Y dω: the sampler's density in uv, Y sin(πv) / ∫∫ Y sin(πv) du dv, over the
     /// Jacobian dω / du dv = 2π² sin θ (the sin θ cancels).
     fn pdf_uv(&self, uv: DVec2) -> f64 {
-        if self.inv_integral == 0.0 {
-            return 0.0;
-        }
-        self.bilinear(uv, luminance) * self.inv_integral
+        self.density_of(&self.taps(uv))
     }
 
     /// Draws a direction with density proportional to the luminance of `eval`. `None` when
@@ -435,7 +520,13 @@ impl EnvironmentMap {
         let (l01, l11) = (corner(x, rb), corner(xb, rb));
         // v from the marginal, linear in v (the means of the upper and lower corners) times
         // sin(πv); then u from the linear conditional at that v.
-        let t = sample_patch_row(f.y, PI * v0, PI * dv, 0.5 * (l00 + l10), 0.5 * (l01 + l11));
+        let row = PatchRow {
+            a: PI * v0,
+            c: PI * dv,
+            top: 0.5 * (l00 + l10),
+            bottom: 0.5 * (l01 + l11),
+        };
+        let t = row.sample(f.y);
         let left = (1.0 - t) * l00 + t * l01;
         let right = (1.0 - t) * l10 + t * l11;
         let s = sample_linear(f.x, left, right);
@@ -449,10 +540,11 @@ impl EnvironmentMap {
             // Re-derive uv from the direction, so that the density and radiance equal
             // `pdf(direction)` and `eval(direction)` to the bit.
             let uv = self.uv(direction)?;
-            let pdf = self.pdf_uv(uv);
+            let taps = self.taps(uv);
+            let pdf = self.density_of(&taps);
             (pdf > 0.0).then(|| EnvSample {
                 direction,
-                radiance: self.eval_uv(uv),
+                radiance: self.radiance_of(&taps),
                 pdf,
             })
         };
@@ -563,6 +655,7 @@ mod tests {
             let s = env.sample(u).unwrap();
             assert_eq!(s.radiance, env.eval(s.direction));
             assert_eq!(s.pdf, env.pdf(s.direction));
+            assert_eq!(env.eval_pdf(s.direction), (env.eval(s.direction), s.pdf));
             // Within the 3×3 neighbourhood the bilinear radiance can reach.
             let uv = env.uv(s.direction).unwrap();
             let (px, py) = ((uv.x * 16.0) as i64, (uv.y * 8.0) as i64);
@@ -602,7 +695,10 @@ mod tests {
             (0.0, PI / 16384.0),
             (PI - PI / 16384.0, PI / 16384.0),
         ] {
-            let (p0, p1) = sin_moments(a, c);
+            let (p0, p1) = (
+                patch_row_cdf(a, c, 1.0, 1.0, 1.0),
+                patch_row_cdf(a, c, 0.0, 1.0, 1.0),
+            );
             let q0 = simpson(|r| (a + c * r).sin(), 2000);
             let q1 = simpson(|r| r * (a + c * r).sin(), 2000);
             // Absolute 1e-15: sin near θ = π is only known to the rounding of π (1.2e-16).
@@ -636,10 +732,20 @@ mod tests {
                 let total = patch_row_cdf(a, c, top, bottom, 1.0);
                 for k in 0..=64 {
                     let xi = (k as f64 / 64.0).min(ONE_MINUS_EPS);
-                    let t = sample_patch_row(xi, a, c, top, bottom);
+                    let row = PatchRow { a, c, top, bottom };
+                    let t = row.sample(xi);
                     assert!((0.0..1.0).contains(&t));
                     let f = patch_row_cdf(a, c, top, bottom, t) / total;
                     assert!((f - xi).abs() < 1e-13, "{a} {c} {top} {bottom} {xi}: {f}");
+                    // The density beside the CDF, and the sine at the start.
+                    let p = row.at(t);
+                    let d = ((1.0 - t) * top + t * bottom) * (a + c * t).sin().max(0.0);
+                    assert!(
+                        (p.density - d).abs() <= 1e-14 * (1.0 + d),
+                        "{t}: {}",
+                        p.density
+                    );
+                    assert!((p.sin_start - a.sin().max(0.0)).abs() <= 1e-15);
                 }
             }
         }

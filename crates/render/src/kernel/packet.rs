@@ -540,11 +540,11 @@ impl Kernel<'_> {
         }
         for i in lanes_of(missed) {
             let dir = paths.d.lane(i);
-            let le = e.eval(dir);
+            let (le, pdf) = e.eval_pdf(dir);
             if le.is_black() {
                 continue;
             }
-            let pl = p_select * e.pdf(dir);
+            let pl = p_select * pdf;
             let w = self
                 .emission_weight(
                     paths.delta_prev & (1 << i),
