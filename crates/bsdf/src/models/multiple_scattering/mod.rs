@@ -8,6 +8,7 @@
 //!   energy-compensated [`compensated_conductor`] and [`compensated_dielectric`] [KC17]
 //!   (and the walk models' proxy).
 
+pub mod albedo_quadrature;
 pub mod albedo_tables;
 pub mod compensated_conductor;
 pub mod compensated_dielectric;

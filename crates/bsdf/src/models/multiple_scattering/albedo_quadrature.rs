@@ -1,0 +1,464 @@
+//! One albedo-table entry by adaptive quadrature over the microfacet normals, to a
+//! tolerance and with an error estimate (issue 18; the tables are described in
+//! [`super::albedo_tables`]).
+//!
+//! **The integral.** For light from o (cos θ_o = μ), the single-scattering lobe returns
+//!
+//!   E(μ) = (1/μ) ∫ D(m) ⟨o·m⟩ W(m) dω_m,   W = F G(o, r, m) + (1 − F) G(o, t, m),
+//!
+//! r = reflect(o, m) (counted while above the horizon), t = refract(o, m) (counted while
+//! below it, and while it exists), F the dielectric Fresnel factor at o·m (F = 1 for the
+//! conductor table). This is ∫ f cos θ_i dω_i with dω_i = 4 (o·m) dω_m for reflection and
+//! the refraction Jacobian of WMLT07 eqs. 16–17 for transmission; the visible-normal
+//! estimator weight G/G1(o) of WMLT07 eq. 41 integrated against D_o(m) is the same
+//! integral.
+//!
+//! **Coordinates.** m = (sin θ cos φ, sin θ sin φ, cos θ), and θ is replaced by the
+//! cumulative u of the distribution's own normal sampler (D(m) cos θ dω = du dφ/2π):
+//! u = tan²θ/(α² + tan²θ) for GGX, 1 − exp(−tan²θ/α²) for Beckmann. Then
+//!
+//!   E(μ) = (1/(π μ)) ∫₀^π ∫₀¹ (μ + sin θ_o cos φ tan θ) W(m) du dφ,
+//!
+//! (o in the xz-plane: the integrand is even in φ). The peak of D, of width α, is flattened
+//! away, so that no row of α needs break points of its own.
+//!
+//! **Kinks, located in closed form.** Along a line of constant φ, with
+//! R = √(sin²θ_o cos²φ + μ²) and ψ = atan2(sin θ_o cos φ, μ):
+//! - o·m = R cos(θ − ψ): the facet turns away from o at θ = ψ + π/2 (the end of the line);
+//!   total internal reflection (η < 1) holds where o·m < √(1 − η²): breaks at
+//!   θ = ψ ± acos(√(1 − η²)/R);
+//! - r_z = 2 (o·m) m_z − μ = R cos(2θ − ψ): r crosses the horizon at θ = ψ/2 + π/4, where
+//!   the reflected term ends with a kink; its masking falls from 1 to 0 within r_z ≲ α
+//!   (Smith Λ grows like α/cot θ_r), so breaks also at r_z = α/2 and 2α, and at r_z = μ;
+//! - where the refracted direction crosses the horizon (η < 1) and where the V-cavity or
+//!   Kelemen masking changes branch: sign changes of those quantities on a 24-point scan
+//!   of the line, bisected to machine precision (cheap: no D, no Λ).
+//!
+//! Each piece between breaks gets the graded Gauss–Kronrod rule of
+//! [`integrate_2d_graded`] (the integrand behaves like a square root at u = 0, where
+//! tan θ ∝ √u, and at total internal reflection), the outer integral over φ is cut at
+//! φ = π/2, where the lines change from tilting towards o to tilting away, at the φ
+//! where the TIR band appears, and where ψ = ±45° (at grazing incidence ψ turns from −90°
+//! to 90° within a few μ of φ = 90°). The error estimate is the embedded |K15 − G7| with
+//! the bisection floor ([`ErrorEstimate::Embedded`]): all kinks are break points.
+
+use super::albedo_tables::{estimator_weight, TableFresnel};
+use crate::math::adaptive_quadrature::{integrate_2d_graded, ErrorEstimate, QuadResult, Tolerance};
+use crate::math::{reflect, refract, Vec3, PI};
+use crate::microfacet::{Distribution, Masking, Ndf};
+
+/// Points of the scan that finds the kinks not located in closed form.
+const SCAN: usize = 24;
+/// Bisection steps refining a kink found by the scan: to 2⁻⁴⁰ of a scan interval.
+const BISECTIONS: usize = 40;
+
+/// The substitution of the polar angle: tan θ = α tan x, x ∈ [0, π/2], and the density
+/// du/dx of the distribution's normal sampler in x (D(m) cos θ dω = du dφ/2π).
+#[derive(Clone, Copy, Debug)]
+enum SlopeMap {
+    /// u = sin²x: du/dx = sin 2x.
+    Ggx { alpha: f64 },
+    /// u = 1 − exp(−tan²x): du/dx = 2 tan x (1 + tan²x) exp(−tan²x).
+    Beckmann { alpha: f64 },
+}
+
+impl SlopeMap {
+    fn of(ndf: &Ndf) -> Option<SlopeMap> {
+        match ndf {
+            Ndf::Ggx(g) => Some(SlopeMap::Ggx {
+                alpha: (g.alpha_x() * g.alpha_y()).sqrt(),
+            }),
+            Ndf::Beckmann(b) => Some(SlopeMap::Beckmann {
+                alpha: (b.alpha_x() * b.alpha_y()).sqrt(),
+            }),
+            _ => None,
+        }
+    }
+
+    /// (tan θ, du/dx) at x ∈ [0, π/2).
+    #[inline]
+    fn at(self, x: f64) -> (f64, f64) {
+        match self {
+            SlopeMap::Ggx { alpha } => {
+                let (sx, cx) = x.sin_cos();
+                (alpha * sx / cx, 2.0 * sx * cx)
+            }
+            SlopeMap::Beckmann { alpha } => {
+                let t = x.tan();
+                let t2 = t * t;
+                (alpha * t, 2.0 * t * (1.0 + t2) * (-t2).exp())
+            }
+        }
+    }
+
+    /// x at θ ∈ [0, π/2].
+    #[inline]
+    fn x(self, theta: f64) -> f64 {
+        let (SlopeMap::Ggx { alpha } | SlopeMap::Beckmann { alpha }) = self;
+        if theta >= 0.5 * PI {
+            0.5 * PI
+        } else {
+            (theta.tan() / alpha).atan()
+        }
+    }
+}
+
+/// The normal at polar angle θ (given by tan θ) and azimuth (cos φ, sin φ).
+#[inline]
+fn normal(tan: f64, cos_phi: f64, sin_phi: f64) -> Vec3 {
+    let c = 1.0 / (1.0 + tan * tan).sqrt();
+    let s = tan * c;
+    Vec3::new(s * cos_phi, s * sin_phi, c)
+}
+
+/// The quantities whose sign changes are kinks of W that have no closed form at m: the
+/// refracted direction's height (η < 1) and the branch switches of the V-cavity masking
+/// (r_z = o_z, 2 m_z r_z = o·m, 2 m_z o_z = o·m) or of Kelemen's (2 r_z o_z = 1 + r·o).
+#[inline]
+fn scanned(masking: Masking, fresnel: TableFresnel, o: Vec3, m: Vec3, out: &mut [f64; 4]) {
+    let om = o.dot(m);
+    let r = reflect(o, m);
+    *out = [1.0; 4];
+    match masking {
+        Masking::VCavity => {
+            out[0] = r.z - o.z;
+            out[1] = 2.0 * m.z * r.z - om;
+            out[2] = 2.0 * m.z * o.z - om;
+        }
+        Masking::Kelemen => out[0] = 2.0 * r.z * o.z - (1.0 + r.dot(o)),
+        Masking::SmithSeparable | Masking::SmithCorrelated => {}
+    }
+    if let TableFresnel::Dielectric(eta) = fresnel {
+        if eta < 1.0 {
+            // Outside the refraction band the sign is that of the band's edge (t_z < 0
+            // there, t being nearly tangent to m): no spurious change.
+            out[3] = refract(o, m, 1.0 / eta).map_or(-1.0, |t| t.z);
+        }
+    }
+}
+
+/// The break points (polar angles) of the line at azimuth φ in (0, `end`), pushed unsorted
+/// to `out` (when given); returns how many sign changes of each scanned quantity
+/// ([`scanned`]) the line has.
+fn line_breaks(
+    masking: Masking,
+    fresnel: TableFresnel,
+    alpha: f64,
+    o: Vec3,
+    (cos_phi, sin_phi): (f64, f64),
+    end: f64,
+    mut out: Option<&mut Vec<f64>>,
+) -> [u8; 4] {
+    let mut counts = [0u8; 4];
+    let counting_only = out.is_none();
+    let (s, c) = (o.x, o.z);
+    let sc = s * cos_phi;
+    let big_r = sc.hypot(c);
+    let psi = sc.atan2(c);
+    let mut push = |t: f64| {
+        if let Some(out) = out.as_deref_mut() {
+            if t > 0.0 && t < end {
+                out.push(t);
+            }
+        }
+    };
+    // r_z = R cos(2θ − ψ) = z: 2θ = ψ ± acos(z/R).
+    for z in [0.0, 0.5 * alpha, 2.0 * alpha, c] {
+        if z <= big_r {
+            let a = (z / big_r).acos();
+            push(0.5 * (psi + a));
+            push(0.5 * (psi - a));
+        }
+    }
+    if let TableFresnel::Dielectric(eta) = fresnel {
+        if eta < 1.0 {
+            let k = (1.0 - eta * eta).sqrt();
+            if k <= big_r {
+                let a = (k / big_r).acos();
+                push(psi + a);
+                push(psi - a);
+            }
+        }
+    }
+    let scan_needed = matches!(masking, Masking::VCavity | Masking::Kelemen)
+        || matches!(fresnel, TableFresnel::Dielectric(eta) if eta < 1.0);
+    if scan_needed {
+        let at = |t: f64, v: &mut [f64; 4]| {
+            scanned(masking, fresnel, o, normal(t.tan(), cos_phi, sin_phi), v)
+        };
+        let (mut prev, mut cur) = ([0.0; 4], [0.0; 4]);
+        let x = |k: usize| end * k as f64 / SCAN as f64;
+        at(x(0), &mut prev);
+        for k in 1..=SCAN {
+            at(x(k), &mut cur);
+            for q in 0..4 {
+                if (prev[q] > 0.0) != (cur[q] > 0.0) {
+                    counts[q] += 1;
+                    if counting_only {
+                        continue;
+                    }
+                    let (mut lo, mut hi) = (x(k - 1), x(k));
+                    let mut v = [0.0; 4];
+                    for _ in 0..BISECTIONS {
+                        let mid = 0.5 * (lo + hi);
+                        at(mid, &mut v);
+                        if (v[q] > 0.0) == (prev[q] > 0.0) {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    push(0.5 * (lo + hi));
+                }
+            }
+            prev = cur;
+        }
+    }
+    counts
+}
+
+/// The cuts of the outer integral over φ ∈ [0, π] for light from cos θ_o = μ: the ends;
+/// π/2; where ψ = ±45° (s |cos φ| = μ); where the TIR band appears (R = √(1 − η²)); where
+/// the line's end θ_e (θ* = π/4 + ψ/2 when only reflection counts, ψ + π/2 otherwise) is
+/// α/2, α, 2α or 4α — at grazing incidence it is below α, so that the peak of D is cut
+/// off, for |cos φ| ≲ μ/α.
+fn outer_cuts(mu: f64, alpha: f64, reflection_only: bool, fresnel: TableFresnel) -> Vec<f64> {
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let mut outer = vec![0.0, 0.5 * PI, PI];
+    let mut at_cos = |k: f64| {
+        if s > 0.0 && k.abs() < s {
+            outer.push((k / s).acos());
+        }
+    };
+    at_cos(mu);
+    at_cos(-mu);
+    if let TableFresnel::Dielectric(eta) = fresnel {
+        if eta < 1.0 {
+            let k2 = 1.0 - eta * eta - mu * mu;
+            if k2 > 0.0 {
+                at_cos(k2.sqrt());
+                at_cos(-k2.sqrt());
+            }
+        }
+    }
+    for k in [0.5, 1.0, 2.0, 4.0] {
+        let theta_e = k * alpha;
+        let psi = if reflection_only {
+            2.0 * theta_e - 0.5 * PI
+        } else {
+            theta_e - 0.5 * PI
+        };
+        if psi > -0.5 * PI && psi < 0.0 {
+            // s cos φ / μ = tan ψ.
+            at_cos(mu * psi.tan());
+        }
+    }
+    outer.sort_by(f64::total_cmp);
+    outer.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    outer
+}
+
+/// ∫ f(h, i) dω_h over the half-vectors h whose mirror direction i = reflect(o, h) is above
+/// the horizon, for o at cos θ_o = `mu` in the xz-plane and f even in h_y (an isotropic
+/// lobe), by adaptive quadrature to the relative tolerance `tolerance` — the reflection
+/// part of [`directional_albedo_adaptive`] for lobes given by a half-vector density of
+/// width `width` (KSK01's specular albedo). The polar angle of h is substituted by
+/// tan θ = w tan x, which flattens a peak of width w at the normal; the cuts are those of
+/// [`directional_albedo_adaptive`] (r_z = 0, w/2, 2w, μ along each line; the same outer
+/// cuts).
+pub(crate) fn reflection_integral_adaptive(
+    mu: f64,
+    width: f64,
+    tolerance: f64,
+    f: impl Fn(Vec3, Vec3) -> f64,
+) -> QuadResult {
+    let mu = mu.clamp(1e-6, 1.0);
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let o = Vec3::new(s, 0.0, mu);
+    let w = width.max(1e-12);
+    let outer = outer_cuts(mu, w, true, TableFresnel::One);
+    let tol = Tolerance {
+        rel: tolerance,
+        abs: 1e-3 * tolerance * mu,
+        max_segments: 400,
+        estimate: ErrorEstimate::Embedded,
+    };
+    let line = std::cell::Cell::new((1.0, 0.0));
+    let mut breaks = Vec::with_capacity(16);
+    let q = integrate_2d_graded(
+        &outer,
+        tol,
+        |phi| {
+            let (sin_phi, cos_phi) = phi.sin_cos();
+            line.set((cos_phi, sin_phi));
+            let end = 0.25 * PI + 0.5 * (s * cos_phi).atan2(mu);
+            breaks.clear();
+            line_breaks(
+                Masking::SmithSeparable,
+                TableFresnel::One,
+                w,
+                o,
+                (cos_phi, sin_phi),
+                end,
+                Some(&mut breaks),
+            );
+            let x = |theta: f64| (theta.tan() / w).atan();
+            let mut cuts: Vec<f64> = breaks.iter().map(|&t| x(t)).collect();
+            cuts.push(0.0);
+            cuts.push(x(end));
+            cuts.sort_by(f64::total_cmp);
+            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-15);
+            cuts
+        },
+        |_, x| {
+            let (cos_phi, sin_phi) = line.get();
+            let (sx, cx) = x.sin_cos();
+            let tan = w * sx / cx;
+            let h = normal(tan, cos_phi, sin_phi);
+            let i = reflect(o, h);
+            if !(i.z > 0.0) {
+                return 0.0;
+            }
+            // dω = sin θ dθ dφ, dθ/dx = w sec²x / (1 + tan²θ) = w cos²θ / cos²x.
+            let dtheta = w * h.z * h.z / (cx * cx);
+            let sin_theta = tan * h.z;
+            f(h, i) * sin_theta * dtheta
+        },
+    );
+    // The integrand is even in φ: twice the half-plane.
+    QuadResult {
+        value: 2.0 * q.value,
+        error: 2.0 * q.error,
+        ..q
+    }
+}
+
+/// Directional albedo E(μ) of the single-scattering lobe of `ndf` (isotropic Beckmann or
+/// GGX) with `masking` and `fresnel`, by adaptive quadrature over the microfacet normals
+/// (see the module notes) to the relative tolerance `tolerance`: the value (not clamped,
+/// so that the estimate speaks of it), its estimated absolute error and the evaluations
+/// spent. Other distributions have no tables: a NaN value, not converged.
+pub fn directional_albedo_adaptive(
+    ndf: &Ndf,
+    masking: Masking,
+    fresnel: TableFresnel,
+    mu: f64,
+    tolerance: f64,
+) -> QuadResult {
+    let Some(map) = SlopeMap::of(ndf) else {
+        return QuadResult {
+            value: f64::NAN,
+            error: f64::INFINITY,
+            evaluations: 0,
+            converged: false,
+        };
+    };
+    let mu = mu.clamp(1e-6, 1.0);
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let o = Vec3::new(s, 0.0, mu);
+    let alpha = ndf.typical_width();
+    let reflection_only = matches!(fresnel, TableFresnel::One);
+    let mut outer = outer_cuts(mu, alpha, reflection_only, fresnel);
+    let end_of = |cos_phi: f64| {
+        let psi = (s * cos_phi).atan2(mu);
+        if reflection_only {
+            0.25 * PI + 0.5 * psi
+        } else {
+            (psi + 0.5 * PI).min(0.5 * PI)
+        }
+    };
+    let scan_needed = matches!(masking, Masking::VCavity | Masking::Kelemen)
+        || matches!(fresnel, TableFresnel::Dielectric(eta) if eta < 1.0);
+    if scan_needed {
+        // Where the scanned kinks appear or vanish along the lines (a kink curve turns
+        // back in φ), the inner integral has a square-root singularity in φ: those φ are
+        // outer cuts, found where the lines' counts of kinks change.
+        let counts = |phi: f64| {
+            let (sin_phi, cos_phi) = phi.sin_cos();
+            line_breaks(
+                masking,
+                fresnel,
+                alpha,
+                o,
+                (cos_phi, sin_phi),
+                end_of(cos_phi),
+                None,
+            )
+        };
+        const LINES: usize = 48;
+        let at = |k: usize| PI * k as f64 / LINES as f64;
+        let mut prev = counts(at(0));
+        for k in 1..=LINES {
+            let cur = counts(at(k));
+            if cur != prev {
+                let (mut lo, mut hi) = (at(k - 1), at(k));
+                for _ in 0..30 {
+                    let mid = 0.5 * (lo + hi);
+                    if counts(mid) == prev {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                outer.push(0.5 * (lo + hi));
+            }
+            prev = cur;
+        }
+        outer.sort_by(f64::total_cmp);
+        outer.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    }
+    let scale = 1.0 / (PI * mu);
+    let tol = Tolerance {
+        rel: tolerance,
+        // E ≥ 0 and mostly near 1; the floor (on E, hence the scale) keeps entries with
+        // E → 0 finite in cost.
+        abs: 1e-3 * tolerance / scale,
+        max_segments: 400,
+        estimate: ErrorEstimate::Embedded,
+    };
+    let mut breaks = Vec::with_capacity(16);
+    // (cos φ, sin φ) of the line being integrated, set with its cuts.
+    let line = std::cell::Cell::new((1.0, 0.0));
+    let q = integrate_2d_graded(
+        &outer,
+        tol,
+        |phi| {
+            let (sin_phi, cos_phi) = phi.sin_cos();
+            line.set((cos_phi, sin_phi));
+            // The line ends where the facet turns away from o, or for the conductor where
+            // r leaves the upper hemisphere.
+            let end = end_of(cos_phi);
+            breaks.clear();
+            line_breaks(
+                masking,
+                fresnel,
+                alpha,
+                o,
+                (cos_phi, sin_phi),
+                end,
+                Some(&mut breaks),
+            );
+            let mut cuts: Vec<f64> = breaks.iter().map(|&t| map.x(t)).collect();
+            cuts.push(0.0);
+            cuts.push(map.x(end));
+            cuts.sort_by(f64::total_cmp);
+            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-15);
+            cuts
+        },
+        |_, x| {
+            let (cos_phi, sin_phi) = line.get();
+            let (tan, du) = map.at(x);
+            let m = normal(tan, cos_phi, sin_phi);
+            let w = estimator_weight(ndf, masking, fresnel, o, m).0;
+            if w == 0.0 {
+                return 0.0;
+            }
+            (mu + s * cos_phi * tan) * w * du
+        },
+    );
+    QuadResult {
+        value: q.value * scale,
+        error: q.error * scale,
+        ..q
+    }
+}
