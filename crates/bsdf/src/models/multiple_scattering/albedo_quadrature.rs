@@ -42,8 +42,10 @@
 //! to 90° within a few μ of φ = 90°). The error estimate is the embedded |K15 − G7| with
 //! the bisection floor ([`ErrorEstimate::Embedded`]): all kinks are break points.
 
-use super::albedo_tables::{estimator_weight, TableFresnel};
+use super::albedo_tables::TableFresnel;
+use crate::fresnel::fresnel_dielectric;
 use crate::math::adaptive_quadrature::{integrate_2d_graded, ErrorEstimate, QuadResult, Tolerance};
+use crate::math::special::beta;
 use crate::math::{reflect, refract, Vec3, PI};
 use crate::microfacet::{Distribution, Masking, Ndf};
 
@@ -99,6 +101,75 @@ impl SlopeMap {
             0.5 * PI
         } else {
             (theta.tan() / alpha).atan()
+        }
+    }
+}
+
+/// W(m) of the module notes for one view o: the estimator weight of
+/// `albedo_tables::estimator_weight` with Λ(o) computed once (the Smith forms; the V-cavity and Kelemen
+/// masking are cheap and use [`Masking::g`]).
+struct EntryWeight<'a> {
+    ndf: &'a Ndf,
+    masking: Masking,
+    fresnel: TableFresnel,
+    o: Vec3,
+    lambda_o: f64,
+}
+
+impl<'a> EntryWeight<'a> {
+    fn new(ndf: &'a Ndf, masking: Masking, fresnel: TableFresnel, o: Vec3) -> Self {
+        EntryWeight {
+            ndf,
+            masking,
+            fresnel,
+            o,
+            lambda_o: ndf.lambda(o),
+        }
+    }
+
+    /// G(o, v, m) for v on the side given by `reflection` (o·m > 0 and o above: the
+    /// caller's checks), as [`Masking::g`] computes it.
+    #[inline]
+    fn g(&self, v: Vec3, m: Vec3, reflection: bool) -> f64 {
+        if v.dot(m) * v.z <= 0.0 {
+            return 0.0;
+        }
+        match self.masking {
+            Masking::SmithSeparable => self.ndf.g1(v, m) / (1.0 + self.lambda_o),
+            Masking::SmithCorrelated => {
+                let lv = self.ndf.lambda(v);
+                if reflection {
+                    1.0 / (1.0 + lv + self.lambda_o)
+                } else if lv.is_finite() && self.lambda_o.is_finite() {
+                    beta(1.0 + lv, 1.0 + self.lambda_o)
+                } else {
+                    0.0
+                }
+            }
+            Masking::VCavity | Masking::Kelemen => self.masking.g(self.ndf, v, self.o, m),
+        }
+    }
+
+    /// F G(o, r, m) + (1 − F) G(o, t, m) (r counted above the horizon, t below it).
+    #[inline]
+    fn at(&self, m: Vec3) -> f64 {
+        let o = self.o;
+        let c = o.dot(m);
+        if !(c > 0.0) {
+            return 0.0;
+        }
+        let r = reflect(o, m);
+        let gr = if r.z > 0.0 { self.g(r, m, true) } else { 0.0 };
+        match self.fresnel {
+            TableFresnel::One => gr,
+            TableFresnel::Dielectric(eta) => {
+                let f = fresnel_dielectric(c, eta);
+                let gt = match refract(o, m, 1.0 / eta) {
+                    Some(t) if t.z < 0.0 => self.g(t, m, false),
+                    _ => 0.0,
+                };
+                f * gr + (1.0 - f) * gt
+            }
         }
     }
 }
@@ -218,7 +289,8 @@ fn line_breaks(
 }
 
 /// The cuts of the outer integral over φ ∈ [0, π] for light from cos θ_o = μ: the ends;
-/// π/2; where ψ = ±45° (s |cos φ| = μ); where the TIR band appears (R = √(1 − η²)); where
+/// π/2; where ψ = ±45° (s |cos φ| = μ); where the TIR band appears (R = √(1 − η²)) and
+/// where its upper edge leaves the line (s cos φ = √(1 − η²)); where
 /// the line's end θ_e (θ* = π/4 + ψ/2 when only reflection counts, ψ + π/2 otherwise) is
 /// α/2, α, 2α or 4α — at grazing incidence it is below α, so that the peak of D is cut
 /// off, for |cos φ| ≲ μ/α.
@@ -239,6 +311,9 @@ fn outer_cuts(mu: f64, alpha: f64, reflection_only: bool, fresnel: TableFresnel)
                 at_cos(k2.sqrt());
                 at_cos(-k2.sqrt());
             }
+            // Where the band's upper edge reaches the end of the line, θ = π/2 (the
+            // horizontal facet there has o·m = s cos φ = √(1 − η²)).
+            at_cos((1.0 - eta * eta).sqrt());
         }
     }
     for k in [0.5, 1.0, 2.0, 4.0] {
@@ -416,6 +491,7 @@ pub fn directional_albedo_adaptive(
         max_segments: 400,
         estimate: ErrorEstimate::Embedded,
     };
+    let weight = EntryWeight::new(ndf, masking, fresnel, o);
     let mut breaks = Vec::with_capacity(16);
     // (cos φ, sin φ) of the line being integrated, set with its cuts.
     let line = std::cell::Cell::new((1.0, 0.0));
@@ -449,7 +525,7 @@ pub fn directional_albedo_adaptive(
             let (cos_phi, sin_phi) = line.get();
             let (tan, du) = map.at(x);
             let m = normal(tan, cos_phi, sin_phi);
-            let w = estimator_weight(ndf, masking, fresnel, o, m).0;
+            let w = weight.at(m);
             if w == 0.0 {
                 return 0.0;
             }
@@ -460,5 +536,45 @@ pub fn directional_albedo_adaptive(
         value: q.value * scale,
         error: q.error * scale,
         ..q
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::rng::{Pcg32, RandomSource};
+    use crate::math::spherical_direction;
+    use crate::microfacet::{Beckmann, Ggx};
+
+    #[test]
+    fn the_entry_weight_is_the_estimator_weight() {
+        let mut rng = Pcg32::new(9, 4);
+        for ndf in [
+            Ndf::Ggx(Ggx::isotropic(0.4).unwrap()),
+            Ndf::Beckmann(Beckmann::isotropic(0.7).unwrap()),
+        ] {
+            for masking in [
+                Masking::SmithSeparable,
+                Masking::SmithCorrelated,
+                Masking::VCavity,
+            ] {
+                for fresnel in [
+                    TableFresnel::One,
+                    TableFresnel::Dielectric(1.5),
+                    TableFresnel::Dielectric(1.0 / 1.5),
+                ] {
+                    for _ in 0..2000 {
+                        let o = spherical_direction(1.5 * rng.next_f64(), 0.0);
+                        let m = spherical_direction(1.5 * rng.next_f64(), 6.3 * rng.next_f64());
+                        let a = EntryWeight::new(&ndf, masking, fresnel, o).at(m);
+                        let b = super::super::albedo_tables::estimator_weight(
+                            &ndf, masking, fresnel, o, m,
+                        )
+                        .0;
+                        assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-300), "{a} {b}");
+                    }
+                }
+            }
+        }
     }
 }

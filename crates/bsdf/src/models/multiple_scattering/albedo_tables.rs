@@ -30,25 +30,29 @@
 //!   along each line, and across lines where a region appears), each piece with a
 //!   16-point Gauss–Legendre rule per dimension; no error estimate.
 //!
-//! Measured on all 39 rough rows × 32 columns against the adaptive rule at tolerance 1e-10
-//! (smith-correlated masking unless said; build times on 2 cores shared with another
-//! engineer's benchmarks, load 1.5–3, hence the ranges; `examples/albedo_table_cost.rs`):
+//! Measured on all 39 rough rows × 32 columns (1248 entries) against the adaptive rule at
+//! tolerance 1e-10 (itself checked against 256- and 512-point fixed pieces), in one run on
+//! the 2 cores shared with another engineer's benchmarks (load 2.9–3.5; build times vary
+//! ±50 % with the load; `examples/albedo_table_cost.rs`):
 //!
-//! | table | fixed 16: build, max abs / rel error | adaptive 1e-4: build, max abs / rel error, largest estimate |
+//! | table (smith-correlated unless said) | fixed 16-point: build, max abs / rel error | adaptive 1e-4 (default): build, max abs / rel error, largest estimate, entries above their estimate |
 //! |---|---|---|
-//! | GGX, F = 1 | 0.06–0.17 s, 8.5e-4 / 1.5e-3 | 0.13–0.25 s, 4.8e-6 / 2.4e-5, 5.8e-5 |
-//! | GGX, η = 1.5 | 0.49–1.15 s, 5.8e-4 / 5.5e-3 | 0.34–0.84 s, 7.3e-6 / 1.2e-5, 3.6e-5 |
-//! | GGX, η = 1/1.5 | 0.51–0.87 s, 1.1e-3 / 2.8e-2 | 0.60–1.74 s, 6.3e-5 / 2.3e-4, 8.8e-5 |
-//! | Beckmann, F = 1 | 0.26 s, 2.2e-3 / 4.2e-3 | 0.34 s, 6.1e-5 / 6.1e-5, 8.9e-5 |
-//! | GGX v-cavity, F = 1 | 0.08–0.15 s, 2.0e-2 / 2.0e-2 | 0.59–1.02 s, 2.5e-5 / 2.5e-5, 9.9e-5 |
+//! | GGX conductor (F = 1) | 0.060 s, 8.5e-4 / 1.5e-3 | 0.108 s, 4.8e-6 / 2.4e-5, 5.8e-5, 1 |
+//! | GGX dielectric, η = 1.5 side | 0.478 s, 5.8e-4 / 5.5e-3 | 0.344 s, 7.3e-6 / 1.2e-5, 3.6e-5, 0 |
+//! | GGX dielectric, η = 1/1.5 side | 0.425 s, 1.1e-3 / 2.8e-2 | 0.745 s, 3.1e-5 / 6.7e-5, 8.8e-5, 6 |
+//! | Beckmann conductor | 0.295 s, 2.2e-3 / 4.2e-3 | 0.605 s, 6.1e-5 / 6.1e-5, 8.9e-5, 0 |
+//! | Beckmann dielectric, η = 1.5 side | 0.754 s, 6.2e-4 / 4.1e-3 | 1.587 s, 4.6e-5 / 6.3e-5, 8.2e-5, 1 |
+//! | Beckmann dielectric, η = 1/1.5 side | 1.453 s, 4.4e-3 / 5.6e-3 | 2.797 s, 4.3e-5 / 1.1e-4, 8.5e-5, 1 |
+//! | GGX conductor, v-cavity masking | 0.091 s, 2.0e-2 / 2.0e-2 | 0.922 s, 2.5e-5 / 2.5e-5, 9.9e-5, 7 |
 //!
-//! The former reference (the visible-normal integrand by nested Gauss–Kronrod at 1e-9) was
-//! itself off by up to 1.5e-7 at α ≥ 7, μ ≥ 0.6 (E ≈ 1e-3): 256-point fixed pieces agree
-//! with the new rule there. The estimate is not a proof: it bounds the actual error of
-//! every entry of the GGX F = 1 and η = 1.5 tables at 1e-5, but in 1–20 of the 1248
-//! entries of the others (η < 1 near μ ≈ 0.3 and 0.5, where the refracted direction's
-//! horizon crossing turns back in φ; the v-cavity branch switches) the error exceeds its
-//! estimate, while staying below the tolerance.
+//! The first attempt at adaptive entries (issue 18: nested Gauss–Kronrod over the
+//! visible-normal sampler's unit square, cuts located by bisection of a signature) cost
+//! 6.0 s and 11.0 s for the first two tables at 1e-5, and its tolerance-1e-9 reference was
+//! off by up to 1.5e-7 at α ≥ 7, μ ≥ 0.6 (E ≈ 1e-3; 256-point fixed pieces agree with the
+//! new rule there). The estimate is not a proof: in the entries counted in the last column
+//! (η < 1 near μ ≈ 0.6–0.8, close to the critical angle; the v-cavity branch switches) the
+//! error exceeds its estimate, by up to 17×, while staying below the tolerance.
+//! The table's interpolation error (below) is 30–300× the entries' error.
 //!
 //! **Layout.** 40 values of α at s = α/(1 + α) = (10/11)(j/39)^1.5 (α from 0 to 10, the
 //! distributions' range; dense at small α, where E changes with μ/α), times 32 values of μ at
