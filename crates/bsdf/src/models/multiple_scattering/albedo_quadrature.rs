@@ -13,14 +13,17 @@
 //! estimator weight G/G1(o) of WMLT07 eq. 41 integrated against D_o(m) is the same
 //! integral.
 //!
-//! **Coordinates.** m = (sin θ cos φ, sin θ sin φ, cos θ), and θ is replaced by the
-//! cumulative u of the distribution's own normal sampler (D(m) cos θ dω = du dφ/2π):
-//! u = tan²θ/(α² + tan²θ) for GGX, 1 − exp(−tan²θ/α²) for Beckmann. Then
+//! **Coordinates.** m = (sin θ cos φ, sin θ sin φ, cos θ), and θ is replaced by x with
+//! tan θ = α tan x, x ∈ [0, π/2]. With u the cumulative of the distribution's own normal
+//! sampler (D(m) cos θ dω = du dφ/2π) — u = sin²x for GGX, 1 − exp(−tan²x) for Beckmann —
 //!
-//!   E(μ) = (1/(π μ)) ∫₀^π ∫₀¹ (μ + sin θ_o cos φ tan θ) W(m) du dφ,
+//!   E(μ) = (1/(π μ)) ∫₀^π ∫₀^{π/2} (μ + sin θ_o cos φ tan θ) W(m) (du/dx) dx dφ
 //!
-//! (o in the xz-plane: the integrand is even in φ). The peak of D, of width α, is flattened
-//! away, so that no row of α needs break points of its own.
+//! (o in the xz-plane: the integrand is even in φ). The peak of D (width α) and GGX's
+//! heavy tail both become smooth and O(1) in x (for GGX the integrand is
+//! 2 (μ sin x cos x + sin θ_o cos φ α sin²x) W), so no row of α needs break points of its
+//! own; u itself as the variable left a (1 − u)^{-1/2} near-singularity at the tail that
+//! cost 10× in error at α ≈ 0.01.
 //!
 //! **Kinks, located in closed form.** Along a line of constant φ, with
 //! R = √(sin²θ_o cos²φ + μ²) and ψ = atan2(sin θ_o cos φ, μ):
@@ -35,11 +38,14 @@
 //!   of the line, bisected to machine precision (cheap: no D, no Λ).
 //!
 //! Each piece between breaks gets the graded Gauss–Kronrod rule of
-//! [`integrate_2d_graded`] (the integrand behaves like a square root at u = 0, where
-//! tan θ ∝ √u, and at total internal reflection), the outer integral over φ is cut at
-//! φ = π/2, where the lines change from tilting towards o to tilting away, at the φ
-//! where the TIR band appears, and where ψ = ±45° (at grazing incidence ψ turns from −90°
-//! to 90° within a few μ of φ = 90°). The error estimate is the embedded |K15 − G7| with
+//! [`integrate_2d_graded`] (the integrand behaves like a square root at total internal
+//! reflection). The outer integral over φ is cut ([`outer_cuts`]) at φ = π/2, where the
+//! lines change from tilting towards o to tilting away; where ψ = ±45° (at grazing
+//! incidence ψ turns from −90° to 90° within a few μ of φ = 90°); where the line's end
+//! comes within a few α of the normal (there the peak of D is cut off); where the TIR
+//! band appears and where its edge leaves the line; and, when kinks are scanned, where
+//! a line's count of them changes (a kink curve turning back in φ), located by bisection
+//! over 48 lines. The error estimate is the embedded |K15 − G7| with
 //! the bisection floor ([`ErrorEstimate::Embedded`]): all kinks are break points.
 
 use super::albedo_tables::TableFresnel;
