@@ -13,7 +13,7 @@
 //! error is kept — or, with `table_tolerance`, by adaptive quadrature over the half-vector
 //! hemisphere (a_s(θ) = ∫ P_H(H) F(H·V) (L·n)/(H·V) dω_H, KSK01 eq. 3 with
 //! dω_L = 4 (H·V) dω_H, cut where L crosses the horizon; see
-//! [`reflection_integral_adaptive`]) to that relative tolerance, whose error estimate is
+//! `albedo_quadrature::reflection_integral_adaptive`) to that relative tolerance, whose error estimate is
 //! kept (`albedo_table_error`). ā_s integrates the interpolated table exactly.
 //!
 //! Sampling (KSK01 §2.1.4, §2.2.1): the specular lobe through H and reflection; the matte

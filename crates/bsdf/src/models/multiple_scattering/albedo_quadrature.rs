@@ -39,7 +39,7 @@
 //!
 //! Each piece between breaks gets the graded Gauss–Kronrod rule of
 //! [`integrate_2d_graded`] (the integrand behaves like a square root at total internal
-//! reflection). The outer integral over φ is cut ([`outer_cuts`]) at φ = π/2, where the
+//! reflection). The outer integral over φ is cut (`outer_cuts`) at φ = π/2, where the
 //! lines change from tilting towards o to tilting away; where ψ = ±45° (at grazing
 //! incidence ψ turns from −90° to 90° within a few μ of φ = 90°); where the line's end
 //! comes within a few α of the normal (there the peak of D is cut off); where the TIR
