@@ -204,7 +204,9 @@ fn il_tables(c: &mut Criterion) {
 /// the conductor's (F = 1) and the dielectric's (η = 1.5 and 1/1.5, both sides).
 fn albedo_tables(c: &mut Criterion) {
     use facette_bsdf::microfacet::{Ggx, Masking, Ndf};
-    use facette_bsdf::models::multiple_scattering::albedo_tables::{AlbedoTable, TableFresnel};
+    use facette_bsdf::models::multiple_scattering::albedo_tables::{
+        AlbedoTable, EntryQuadrature, TableFresnel,
+    };
     let ndf = Ndf::Ggx(Ggx::isotropic(0.3).unwrap());
     let mut g = c.benchmark_group("albedo-table-build");
     g.sample_size(10);
@@ -214,6 +216,17 @@ fn albedo_tables(c: &mut Criterion) {
     ] {
         g.bench_function(name, |b| {
             b.iter(|| black_box(AlbedoTable::build(&ndf, Masking::SmithCorrelated, fresnel)))
+        });
+        // The fixed 16-point entries (the default before issue 18), for comparison.
+        g.bench_function(format!("{name}-fixed16"), |b| {
+            b.iter(|| {
+                black_box(AlbedoTable::build_with(
+                    &ndf,
+                    Masking::SmithCorrelated,
+                    fresnel,
+                    EntryQuadrature::Fixed { points: 16 },
+                ))
+            })
         });
     }
     g.finish();

@@ -185,6 +185,15 @@ pub trait Bsdf: Send + Sync {
         1.0
     }
 
+    /// How far this deterministic model's directional albedo may exceed 1 by construction
+    /// (0 for most models): a tabulated energy compensation returns 1 − E_table(μ) of
+    /// energy where the lobe itself returns E(μ), and the table's bilinear interpolation
+    /// misses E by up to [`COMPENSATION_ERROR`](crate::models::multiple_scattering::albedo_tables::COMPENSATION_ERROR).
+    /// The validation's albedo check allows it.
+    fn albedo_excess(&self) -> f64 {
+        0.0
+    }
+
     /// Relative index η (inside over outside) for transmissive models, else `None`.
     fn relative_ior(&self) -> Option<f64> {
         None

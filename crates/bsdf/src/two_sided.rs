@@ -57,6 +57,11 @@ pub trait OpaqueBsdf: Send + Sync {
     }
 
     /// See [`Bsdf::lobe_width`].
+    /// See [`Bsdf::albedo_excess`].
+    fn albedo_excess(&self) -> f64 {
+        0.0
+    }
+
     fn lobe_width(&self) -> f64 {
         1.0
     }
@@ -150,6 +155,10 @@ impl<M: OpaqueBsdf> Bsdf for TwoSided<M> {
             Some((o, i)) => self.inner.eval_estimate(o, i, ctx, samples, rng),
             None => (Spectrum::ZERO, Spectrum::ZERO),
         }
+    }
+
+    fn albedo_excess(&self) -> f64 {
+        self.inner.albedo_excess()
     }
 
     fn lobe_width(&self) -> f64 {

@@ -1,11 +1,14 @@
 //! `facette tabulate`: tabulates the body term of an interfaced-Lambertian material on a
 //! (θ_i, θ_o, φ) grid [TSBRM §4.3] and writes the documented binary table (see
 //! docs/file-formats.md); `--check K` compares K random off-grid pairs with the quadrature.
+//! Entries are QMC estimates (`--samples`) or, with `--tolerance`, deterministic adaptive
+//! quadratures of IL18 eq. 13 with an error estimate each.
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::math::spherical_direction;
+use facette_bsdf::microfacet::integral::{check_tolerance, TableEntries, TOLERANCE_RANGE};
 use facette_bsdf::models::il::il_table::BodyTable;
 use facette_bsdf::models::il::il_table_part::{merge_table_parts, TablePart};
 use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
@@ -23,9 +26,13 @@ pub struct TabulateArgs {
     /// Grid step in degrees (must divide 90).
     #[arg(long, default_value_t = 5.0)]
     step: f64,
-    /// Microfacet samples per entry.
+    /// Microfacet samples per entry (randomized QMC, with a standard error).
     #[arg(long, default_value_t = 10_000, value_parser = crate::counts::count::<8, { crate::counts::QUADRATURE }>)]
     samples: usize,
+    /// Compute each entry by adaptive quadrature to this relative tolerance instead of
+    /// `--samples` (deterministic, with an error estimate; 1e-12 to 0.1).
+    #[arg(long, value_name = "REL", conflicts_with = "samples", value_parser = tolerance)]
+    tolerance: Option<f64>,
     /// Output file (.fctab).
     #[arg(short, long, value_name = "FILE")]
     output: std::path::PathBuf,
@@ -36,6 +43,16 @@ pub struct TabulateArgs {
     /// Compare the table with the quadrature on this many random off-grid direction pairs.
     #[arg(long, value_name = "K", default_value_t = 0, value_parser = crate::counts::count::<0, { crate::counts::QUADRATURE }>)]
     check: usize,
+}
+
+/// Parses `--tolerance`: a finite number in the range of the `tolerance` key (the error
+/// gives the range).
+fn tolerance(s: &str) -> Result<f64, String> {
+    let t: f64 = s.trim().parse().map_err(|_| {
+        let (lo, hi) = TOLERANCE_RANGE;
+        format!("`{s}` is not a number (expected {lo:e} <= tolerance <= {hi})")
+    })?;
+    check_tolerance(t).map_err(|e| e.to_string())
 }
 
 pub fn run(a: TabulateArgs) -> Result<ExitCode> {
@@ -55,6 +72,10 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
         ),
     };
     let lobe = il.lobe().expect("rough").clone();
+    let entries = match a.tolerance {
+        Some(tolerance) => TableEntries::Adaptive { tolerance },
+        None => TableEntries::Samples(a.samples),
+    };
     if let Some(part) = &a.part {
         let (k, n) = crate::cmd_render::parse_part(part)?;
         if a.output.extension().is_none_or(|e| e != "fctpart") {
@@ -68,7 +89,7 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
         }
         let pb = crate::progress::bar(0, "tabulating");
         let start = Instant::now();
-        let p = TablePart::build(&lobe, il.ni(), a.step, a.samples, k, n, &|done, total| {
+        let p = TablePart::build_with(&lobe, il.ni(), a.step, entries, k, n, &|done, total| {
             pb.set_length(total as u64);
             pb.set_position(done as u64);
         })
@@ -86,7 +107,7 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
     }
     let pb = crate::progress::bar(0, "tabulating");
     let start = Instant::now();
-    let t = BodyTable::build(&lobe, il.ni(), a.step, a.samples, &|done, total| {
+    let t = BodyTable::build_with(&lobe, il.ni(), a.step, entries, &|done, total| {
         pb.set_length(total as u64);
         pb.set_position(done as u64);
     })
@@ -96,13 +117,14 @@ pub fn run(a: TabulateArgs) -> Result<ExitCode> {
     t.save(&a.output)
         .with_context(|| format!("cannot write {}", a.output.display()))?;
     println!(
-        "wrote {} ({}×{}×{} entries, {} samples each, {:.2} s; relative standard error of the entries with θ < 90°: mean {:.2e}, max {:.2e})",
+        "wrote {} ({}×{}×{} entries, {}, {:.2} s; {} of the entries with θ < 90°: mean {:.2e}, max {:.2e})",
         a.output.display(),
         t.n_theta,
         t.n_theta,
         t.n_phi,
-        t.samples,
+        entries_text(&t),
         secs,
+        error_text(&t),
         t.mean_stderr,
         t.max_stderr
     );
@@ -189,15 +211,33 @@ pub fn merge(parts: &[std::path::PathBuf], output: &std::path::Path) -> Result<E
         .save(output)
         .with_context(|| format!("cannot write {}", output.display()))?;
     println!(
-        "wrote {} (merged {} parts: {}×{}×{} entries, {} samples each; relative standard error mean {:.2e}, max {:.2e})",
+        "wrote {} (merged {} parts: {}×{}×{} entries, {}; {} mean {:.2e}, max {:.2e})",
         output.display(),
         parts.len(),
         table.n_theta,
         table.n_theta,
         table.n_phi,
-        table.samples,
+        entries_text(&table),
+        error_text(&table),
         table.mean_stderr,
         table.max_stderr
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// "10000 samples each" or "adaptive, tolerance 1e-6".
+fn entries_text(t: &BodyTable) -> String {
+    match t.tolerance {
+        Some(tol) => format!("adaptive quadrature, tolerance {tol:e}"),
+        None => format!("{} samples each", t.samples),
+    }
+}
+
+/// What the table's error figures are.
+fn error_text(t: &BodyTable) -> &'static str {
+    if t.tolerance.is_some() {
+        "relative error estimate"
+    } else {
+        "relative standard error"
+    }
 }

@@ -54,13 +54,43 @@ pub const TOLERANCE_RANGE: (f64, f64) = (1e-12, 0.1);
 
 /// Checks a `tolerance` value against [`TOLERANCE_RANGE`].
 pub fn check_tolerance(tolerance: f64) -> ParamResult<f64> {
+    check_tolerance_named("tolerance", tolerance)
+}
+
+/// Checks a tolerance given under the key `name` against [`TOLERANCE_RANGE`] (finite, in
+/// [1e-12, 0.1]; the error names the key and the range).
+pub fn check_tolerance_named(name: &str, tolerance: f64) -> ParamResult<f64> {
+    if !tolerance.is_finite() {
+        // The range is part of the message here too.
+        return Err(ParamError::OutOfRange {
+            name: name.into(),
+            value: tolerance,
+            expected: format!(
+                "a finite number, {} <= {name} <= {}",
+                crate::math::fmt_num(TOLERANCE_RANGE.0),
+                crate::math::fmt_num(TOLERANCE_RANGE.1)
+            ),
+        });
+    }
     crate::checks::check_range(
-        "tolerance",
+        name,
         tolerance,
         TOLERANCE_RANGE.0,
         TOLERANCE_RANGE.1,
         crate::checks::Bounds::Closed,
     )
+}
+
+/// How the entries of a table of integrals are computed (KSK01's albedo table, IL body
+/// tables).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TableEntries {
+    /// Randomized QMC with this many points per entry (8 rotations), with its standard
+    /// error.
+    Samples(usize),
+    /// Adaptive quadrature to this relative tolerance, with its error estimate
+    /// ([`crate::math::adaptive_quadrature`]); deterministic.
+    Adaptive { tolerance: f64 },
 }
 
 /// Number of independent rotations of the QMC point set (gives the standard error).

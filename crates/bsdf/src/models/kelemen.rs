@@ -8,9 +8,13 @@
 //!   average. With k = 1 the total albedo is exactly 1 at every angle [KSK01 eq. 7].
 //!
 //! a_s(θ) is tabulated when the material is built (91 angles, 0°…90°, linear interpolation),
-//! each entry by the Monte Carlo quadrature of KSK01 §2.1.5 with the specular sampler —
-//! randomized QMC with `table_samples` points in 8 rotations, whose standard error is kept
-//! (`albedo_table_stderr`). ā_s integrates the interpolated table exactly.
+//! each entry either by the Monte Carlo quadrature of KSK01 §2.1.5 with the specular
+//! sampler — randomized QMC with `table_samples` points in 8 rotations, whose standard
+//! error is kept — or, with `table_tolerance`, by adaptive quadrature over the half-vector
+//! hemisphere (a_s(θ) = ∫ P_H(H) F(H·V) (L·n)/(H·V) dω_H, KSK01 eq. 3 with
+//! dω_L = 4 (H·V) dω_H, cut where L crosses the horizon; see
+//! `albedo_quadrature::reflection_integral_adaptive`) to that relative tolerance, whose error estimate is
+//! kept (`albedo_table_error`). ā_s integrates the interpolated table exactly.
 //!
 //! Sampling (KSK01 §2.1.4, §2.2.1): the specular lobe through H and reflection; the matte
 //! lobe by the inverse cumulative table of (1 − a_s(θ)) cos θ. KSK01 writes the cumulative as
@@ -29,6 +33,7 @@
 //! | `ior` | index of the Fresnel term (dielectric) | > 1 | 1.5 |
 //! | `kd` | matte colour k (number or RGB) | [0, 1] | 0.5 |
 //! | `table_samples` | QMC samples per albedo-table entry | ≥ 64 | 16384 |
+//! | `table_tolerance` | relative tolerance of adaptive albedo-table entries (instead of `table_samples`) | [1e-12, 0.1] | — |
 
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_reflectance};
@@ -40,6 +45,8 @@ use crate::math::spectrum::Spectrum;
 use crate::math::warp::hammersley;
 use crate::math::{reflect, Vec3, PI, TWO_PI};
 use crate::microfacet::half_vector_density::HalfVectorDensity;
+use crate::microfacet::integral::{check_tolerance_named, TableEntries};
+use crate::models::multiple_scattering::albedo_quadrature::reflection_integral_adaptive;
 use crate::two_sided::OpaqueBsdf;
 
 /// Number of intervals of the albedo table over [0, π/2].
@@ -60,7 +67,10 @@ pub struct Kelemen {
 struct KelemenTables {
     /// a_s(θ_k), θ_k = k·(π/2)/TABLE_INTERVALS, clamped to [0, 1].
     albedo: Vec<Spectrum>,
-    albedo_stderr: f64,
+    /// Largest standard error (sampled entries) or estimated error (adaptive entries).
+    albedo_error: f64,
+    /// Per entry: the standard error or the error estimate (channel average).
+    entry_errors: Vec<f64>,
     average: Spectrum,
     /// Cumulative of the matte sampling density in θ (piecewise linear g(θ) =
     /// (1 − ā_s(θ)) cos θ sin θ on the table grid).
@@ -75,15 +85,33 @@ impl Kelemen {
         kd: Spectrum,
         table_samples: usize,
     ) -> ParamResult<Self> {
+        Self::with_entries(density, fresnel, kd, TableEntries::Samples(table_samples))
+    }
+
+    /// [`Kelemen::new`] with the albedo table's entries sampled or adaptive
+    /// (`TableEntries::Adaptive`: `table_tolerance`).
+    pub fn with_entries(
+        density: HalfVectorDensity,
+        fresnel: Fresnel,
+        kd: Spectrum,
+        entries: TableEntries,
+    ) -> ParamResult<Self> {
         check_reflectance("kd", kd)?;
-        check_min_count("table_samples", table_samples, 64)?;
+        match entries {
+            TableEntries::Samples(n) => {
+                check_min_count("table_samples", n, 64)?;
+            }
+            TableEntries::Adaptive { tolerance } => {
+                check_tolerance_named("table_tolerance", tolerance)?;
+            }
+        }
         let mut k = Kelemen {
             density,
             fresnel,
             kd,
             tables: Default::default(),
         };
-        k.tables = std::sync::Arc::new(k.build_tables(table_samples));
+        k.tables = std::sync::Arc::new(k.build_tables(entries));
         Ok(k)
     }
 
@@ -93,17 +121,60 @@ impl Kelemen {
         Ok(Kelemen { kd, ..self.clone() })
     }
 
+    /// a_s(θ) at cos θ = μ by adaptive quadrature to the relative tolerance `tolerance`
+    /// (KSK01 eq. 3 integrated over the half-vectors; see the module notes): the value per
+    /// channel and the largest estimated error. A Fresnel factor that is the same in every
+    /// channel is integrated once.
+    fn albedo_adaptive(&self, mu: f64, tolerance: f64) -> (Spectrum, f64) {
+        let grey = matches!(self.fresnel, Fresnel::Dielectric { .. } | Fresnel::One);
+        let channels = if grey {
+            1
+        } else {
+            crate::math::spectrum::CHANNELS
+        };
+        let mut value = Spectrum::ZERO;
+        let mut error = 0.0f64;
+        for ch in 0..channels {
+            let q = reflection_integral_adaptive(
+                mu,
+                self.density.typical_width(),
+                tolerance,
+                |h, i| {
+                    let c = i.dot(h);
+                    if !(c > 0.0) {
+                        return 0.0;
+                    }
+                    // f_s cos θ_L dω_L = P_H F / (4 (H·V)²) · (L·n) · 4 (H·V) dω_H.
+                    self.fresnel.eval(c)[ch] * self.density.density(h) * i.z / c
+                },
+            );
+            value[ch] = q.value;
+            error = error.max(q.error);
+        }
+        if grey {
+            value = Spectrum::splat(value[0]);
+        }
+        (value, error)
+    }
+
     /// Builds a_s(θ) [KSK01 §2.1.5], its average and the matte sampling table.
-    fn build_tables(&self, samples: usize) -> KelemenTables {
+    fn build_tables(&self, entries: TableEntries) -> KelemenTables {
         let mut t = KelemenTables::default();
         use rayon::prelude::*;
         const ROT: usize = 8;
+        let samples = match entries {
+            TableEntries::Samples(n) => n,
+            TableEntries::Adaptive { .. } => 0,
+        };
         let per = (samples / ROT).max(8) as u32;
         let step = 0.5 * PI / TABLE_INTERVALS as f64;
         let rows: Vec<(Spectrum, f64)> = (0..=TABLE_INTERVALS)
             .into_par_iter()
             .map(|k| {
                 let theta = (k as f64 * step).min(0.5 * PI - 1e-6);
+                if let TableEntries::Adaptive { tolerance } = entries {
+                    return self.albedo_adaptive(theta.cos(), tolerance);
+                }
                 let w = Vec3::new(theta.sin(), 0.0, theta.cos());
                 let mut rng = Pcg32::new(0x00a1_bed0, k as u64);
                 let mut means = [Spectrum::ZERO; ROT];
@@ -132,7 +203,8 @@ impl Kelemen {
             .iter()
             .map(|r| r.0.map(|v| v.clamp(0.0, 1.0)))
             .collect();
-        t.albedo_stderr = rows.iter().map(|r| r.1).fold(0.0, f64::max);
+        t.entry_errors = rows.iter().map(|r| r.1).collect();
+        t.albedo_error = rows.iter().map(|r| r.1).fold(0.0, f64::max);
         // ā_s = 2 ∫ a_s(θ) cos θ sin θ dθ of the interpolated table, segment by segment.
         let gl = GaussLegendre::new(8);
         let mut avg = Spectrum::ZERO;
@@ -169,9 +241,17 @@ impl Kelemen {
         self.tables.average
     }
 
-    /// Largest standard error of the a_s table entries.
+    /// Largest standard error of the a_s table entries (sampled entries), or their largest
+    /// estimated absolute error (adaptive entries).
     pub fn albedo_table_stderr(&self) -> f64 {
-        self.tables.albedo_stderr
+        self.tables.albedo_error
+    }
+
+    /// The tabulated a_s(θ_k) at θ_k = k·1° (k = 0…90; 90° is evaluated 1e-6 rad above the
+    /// horizon) and its error: the standard error (sampled entries, channel average) or
+    /// the estimated absolute error (adaptive entries).
+    pub fn albedo_table_entry(&self, k: usize) -> (Spectrum, f64) {
+        (self.tables.albedo[k], self.tables.entry_errors[k])
     }
 
     /// KSK01 §2.2.1's Russian-roulette probabilities for a path arriving along `wo`:
@@ -381,4 +461,92 @@ fn albedo_in(table: &[Spectrum], theta: f64) -> Spectrum {
     let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
     let t = x - k as f64;
     table[k] * (1.0 - t) + table[k + 1] * t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::adaptive_quadrature::{integrate_2d, InnerRange, Tolerance};
+    use crate::math::spherical_direction;
+
+    /// a_s(θ_o) [KSK01 §2.1.5] by an independent quadrature: f_s(o, i) cos θ_i over the
+    /// hemisphere of i in (φ_i, θ_i), cut at the mirror direction (θ_o, π) ± a few widths.
+    fn albedo_over_directions(k: &Kelemen, theta_o: f64, width: f64) -> (f64, f64) {
+        let o = Vec3::new(theta_o.sin(), 0.0, theta_o.cos());
+        let dphi: Vec<f64> = [0.5, 1.0, 2.0, 4.0]
+            .iter()
+            .flat_map(|s| {
+                let d = (2.0 * s * width / theta_o.sin().max(1e-3)).min(0.9 * PI);
+                [PI - d, PI + d]
+            })
+            .collect();
+        let q = integrate_2d(
+            0.0,
+            TWO_PI,
+            &[&[PI][..], &dphi].concat(),
+            Tolerance::relative(1e-10),
+            |_| InnerRange {
+                lo: 0.0,
+                hi: 0.5 * PI,
+                breaks: [-4.0, -2.0, -1.0, 0.0, 1.0, 2.0, 4.0]
+                    .iter()
+                    .map(|s| theta_o + 2.0 * s * width)
+                    .collect(),
+            },
+            |phi, theta| {
+                let i = spherical_direction(theta, phi);
+                k.specular(o, i)[0] * i.z * theta.sin()
+            },
+        );
+        (q.value, q.error)
+    }
+
+    #[test]
+    fn adaptive_albedo_table_meets_its_tolerance() {
+        for (density, tol) in [
+            (HalfVectorDensity::new("ward", 0.3).unwrap(), 1e-6),
+            (HalfVectorDensity::new("beckmann", 0.1).unwrap(), 1e-4),
+            (HalfVectorDensity::new("phong", 40.0).unwrap(), 1e-6),
+        ] {
+            let fresnel = Fresnel::Dielectric { eta: 1.5 };
+            let kd = Spectrum::splat(0.5);
+            let k = Kelemen::with_entries(
+                density,
+                fresnel,
+                kd,
+                TableEntries::Adaptive { tolerance: tol },
+            )
+            .unwrap();
+            assert!(k.albedo_table_stderr() <= tol);
+            let sampled = Kelemen::new(density, fresnel, kd, 1 << 16).unwrap();
+            for deg in [0, 30, 60, 80, 89] {
+                let (a, est) = k.albedo_table_entry(deg);
+                let (r, r_err) =
+                    albedo_over_directions(&k, (deg as f64).to_radians(), density.typical_width());
+                let err = (a[0] - r).abs();
+                let what = format!(
+                    "{} at {deg}°: {a:?} ± {est:.1e} vs {r} ± {r_err:.1e}",
+                    density.name()
+                );
+                assert!(err <= tol * r + r_err + 1e-12, "{what}");
+                assert!(err <= est + r_err + 1e-12, "{what}");
+                // The QMC table agrees within its standard errors.
+                let (b, se) = sampled.albedo_table_entry(deg);
+                assert!(
+                    (b[0] - a[0]).abs() <= 4.0 * se + tol,
+                    "{what}: QMC {b:?} ± {se:.1e}"
+                );
+            }
+        }
+        // The tolerance is validated with the key's name and range.
+        let e = Kelemen::with_entries(
+            HalfVectorDensity::new("ward", 0.3).unwrap(),
+            Fresnel::Dielectric { eta: 1.5 },
+            Spectrum::splat(0.5),
+            TableEntries::Adaptive { tolerance: 0.2 },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("table_tolerance") && e.contains("0.1"), "{e}");
+    }
 }

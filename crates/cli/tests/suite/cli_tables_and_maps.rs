@@ -4,6 +4,70 @@
 use crate::common::*;
 
 #[test]
+fn adaptive_tables_are_deterministic_merge_from_parts_and_validate_the_tolerance() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = r#"{type = "il", ni = 1.4, distribution = "ggx", alpha = 0.5}"#;
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let tab = |extra: &[&str], out: &str| {
+        let mut args = vec!["tabulate", "--material", m, "--step", "30", "-o", out];
+        args.extend_from_slice(extra);
+        facette(&args, None)
+    };
+    let full = path("full.fctab");
+    let o = tab(&["--tolerance", "1e-4"], &full);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("adaptive quadrature, tolerance 1e-4")
+            && stdout(&o).contains("relative error estimate"),
+        "{}",
+        stdout(&o)
+    );
+    let mut parts = Vec::new();
+    for k in 0..2 {
+        let p = path(&format!("t{k}.fctpart"));
+        let o = tab(&["--tolerance", "1e-4", "--part", &format!("{k}/2")], &p);
+        assert!(o.status.success(), "{}", stderr(&o));
+        parts.push(p);
+    }
+    let merged = path("merged.fctab");
+    let o = facette(&["merge", &parts[0], &parts[1], "-o", &merged], None);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&merged).unwrap(),
+        std::fs::read(&full).unwrap()
+    );
+    // The table is read back by an IL material.
+    let il = format!(
+        r#"{{type = "il", ni = 1.4, distribution = "ggx", alpha = 0.5, table = "{full}"}}"#
+    );
+    let o = facette(
+        &["eval", "--material", &il],
+        Some("theta_i,phi_i,theta_o,phi_o\n30,0,40,90\n"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(rows(&o).len(), 1);
+    // Out-of-range tolerances and --samples with --tolerance are refused clearly.
+    for bad in ["0", "0.5", "nan", "x"] {
+        let o = tab(&["--tolerance", bad], &path("bad.fctab"));
+        assert!(!o.status.success());
+        assert!(
+            stderr(&o).contains("tolerance <= 0.1"),
+            "{bad}: {}",
+            stderr(&o)
+        );
+    }
+    let o = tab(
+        &["--tolerance", "1e-4", "--samples", "64"],
+        &path("bad.fctab"),
+    );
+    assert!(
+        !o.status.success() && stderr(&o).contains("cannot be used with"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn table_parts_merge_into_the_same_table_file() {
     let dir = tempfile::tempdir().unwrap();
     let m = r#"{type = "il", ni = 1.4, distribution = "beckmann", alpha = 0.5}"#;

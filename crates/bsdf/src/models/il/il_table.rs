@@ -8,10 +8,14 @@
 //! TSBRM Fig. 9. Anisotropic distributions would need φ_i as a fourth dimension; tables are
 //! refused for them.
 //!
-//! Entries are computed with the same N microfacet normals for the whole table (randomized
-//! QMC, 8 rotations of a Hammersley set drawn from the D(m)|m·n| sampler), so the table is
-//! smooth and each entry carries a standard error; only θ_i ≤ θ_o is computed, the rest by
-//! reciprocity.
+//! Entries are computed either with the same N microfacet normals for the whole table
+//! (randomized QMC, 8 rotations of a Hammersley set drawn from the D(m)|m·n| sampler), so
+//! the table is smooth and each entry carries a standard error, or — with
+//! [`TableEntries::Adaptive`] (`facette tabulate --tolerance`) — deterministically, each
+//! entry by the adaptive quadrature of `evaluation = "quadrature"`
+//! ([`MicrofacetIntegral::integrate`]: IL18 eq. 13 over the hemisphere of normals, cut at
+//! its kinks) to a relative tolerance, with its error estimate. Only θ_i ≤ θ_o is
+//! computed, the rest by reciprocity.
 //!
 //! ## File format (`.fctab`, version 2, little-endian)
 //!
@@ -22,7 +26,7 @@
 //! | bytes | content |
 //! |---|---|
 //! | 4 | u32 length L of the header |
-//! | L | UTF-8 TOML header: `model = "il-body"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples`, `max_stderr` and `mean_stderr` (relative standard errors of the entries below the grazing row), `facette_version` |
+//! | L | UTF-8 TOML header: `model = "il-body"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples` (0 for adaptive entries), `tolerance` (adaptive entries only), `max_stderr` and `mean_stderr` (relative standard errors — for adaptive entries relative error estimates — of the entries below the grazing row), `facette_version` |
 //! | 8·n_theta²·n_phi | f64 entries, θ_i-major, then θ_o, then φ |
 
 use crate::error::{ParamError, ParamResult};
@@ -31,7 +35,7 @@ use crate::limits;
 use crate::math::rng::{mix_seed, Pcg32, RandomSource};
 use crate::math::warp::hammersley;
 use crate::math::{fmt_num, spherical_direction, Vec3, PI};
-use crate::microfacet::integral::MicrofacetIntegral;
+use crate::microfacet::integral::{check_tolerance, MicrofacetIntegral, TableEntries};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::Distribution;
 use rayon::prelude::*;
@@ -56,8 +60,12 @@ pub struct BodyTable {
     pub step_deg: f64,
     pub n_theta: usize,
     pub n_phi: usize,
+    /// Microfacets per entry (sampled entries; 0 for adaptive ones).
     pub samples: usize,
-    /// Largest and mean relative standard error of the entries below the grazing row.
+    /// The relative tolerance of adaptive entries (`None`: sampled entries).
+    pub tolerance: Option<f64>,
+    /// Largest and mean relative standard error (sampled entries) or relative error
+    /// estimate (adaptive entries) of the entries below the grazing row.
     pub max_stderr: f64,
     pub mean_stderr: f64,
     data: Vec<f64>,
@@ -87,7 +95,18 @@ impl BodyTable {
         samples: usize,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> ParamResult<BodyTable> {
-        let (grid, rows) = compute_rows(lobe, ni, step_deg, samples, &|_| true, progress)?;
+        Self::build_with(lobe, ni, step_deg, TableEntries::Samples(samples), progress)
+    }
+
+    /// [`BodyTable::build`] with sampled or adaptive entries (see the module notes).
+    pub fn build_with(
+        lobe: &SpecularLobe,
+        ni: f64,
+        step_deg: f64,
+        entries: TableEntries,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> ParamResult<BodyTable> {
+        let (grid, rows) = compute_rows(lobe, ni, step_deg, entries, &|_| true, progress)?;
         Ok(BodyTable::assemble(grid, rows))
     }
 
@@ -122,6 +141,7 @@ impl BodyTable {
             n_theta,
             n_phi,
             samples: grid.samples,
+            tolerance: grid.tolerance,
             max_stderr: max_se,
             mean_stderr: sum_se / count.max(1) as f64,
             data,
@@ -187,7 +207,7 @@ impl BodyTable {
 
     fn header(&self) -> String {
         format!(
-            "model = \"il-body\"\nni = {}\ndistribution = \"{}\"\nmasking = \"{}\"\nstep_deg = {}\nn_theta = {}\nn_phi = {}\nsamples = {}\nmax_stderr = {:e}\nmean_stderr = {:e}\nfacette_version = \"{}\"\n",
+            "model = \"il-body\"\nni = {}\ndistribution = \"{}\"\nmasking = \"{}\"\nstep_deg = {}\nn_theta = {}\nn_phi = {}\nsamples = {}\n{}max_stderr = {:e}\nmean_stderr = {:e}\nfacette_version = \"{}\"\n",
             self.ni,
             self.distribution,
             self.masking,
@@ -195,6 +215,7 @@ impl BodyTable {
             self.n_theta,
             self.n_phi,
             self.samples,
+            tolerance_line(self.tolerance),
             self.max_stderr,
             self.mean_stderr,
             env!("CARGO_PKG_VERSION")
@@ -267,6 +288,11 @@ impl BodyTable {
             n_theta: count_of("n_theta")?,
             n_phi: count_of("n_phi")?,
             samples: count_of("samples")?,
+            tolerance: match h.get("tolerance") {
+                None => None,
+                Some(toml::Value::Float(t)) => Some(*t),
+                Some(_) => return Err(bad("header: `tolerance` must be a number".into())),
+            },
         };
         grid.validate().map_err(|m| bad(format!("header: {m}")))?;
         let (max_stderr, mean_stderr) = (f("max_stderr")?, f("mean_stderr")?);
@@ -304,6 +330,7 @@ impl BodyTable {
             n_theta,
             n_phi,
             samples: grid.samples,
+            tolerance: grid.tolerance,
             max_stderr,
             mean_stderr,
             data,
@@ -341,14 +368,22 @@ pub(crate) struct TableGrid {
     pub step_deg: f64,
     pub n_theta: usize,
     pub n_phi: usize,
-    /// Microfacets per entry actually used.
+    /// Microfacets per entry actually used (0 for adaptive entries).
     pub samples: usize,
+    /// The relative tolerance of adaptive entries (`None`: sampled entries).
+    pub tolerance: Option<f64>,
+}
+
+/// The header line of an adaptive table's tolerance (empty for sampled entries).
+pub(crate) fn tolerance_line(tolerance: Option<f64>) -> String {
+    tolerance.map_or(String::new(), |t| format!("tolerance = {t:e}\n"))
 }
 
 impl TableGrid {
     /// Checks every field a file gives: `ni` a valid index, a finite step that divides 90°,
     /// the grid sizes that step implies (n_θ = 90/step + 1, n_φ = 2·90/step + 1) within
-    /// [`limits::TABLE_ENTRIES`], and at least 8 samples. A loader accepts only what
+    /// [`limits::TABLE_ENTRIES`], and at least 8 samples — or, for adaptive entries, 0 samples
+    /// and a tolerance in the range of `tolerance`. A loader accepts only what
     /// [`compute_rows`] could have made, so lookups never meet a NaN step or a grid that
     /// does not match it.
     pub(crate) fn validate(&self) -> Result<(), String> {
@@ -361,11 +396,23 @@ impl TableGrid {
                 self.n_theta, self.n_phi, self.step_deg
             ));
         }
-        if self.samples < 8 {
-            return Err(format!(
-                "samples = {} (a table uses at least 8)",
-                self.samples
-            ));
+        match self.tolerance {
+            Some(t) => {
+                check_tolerance(t).map_err(|e| e.to_string())?;
+                if self.samples != 0 {
+                    return Err(format!(
+                        "samples = {} with tolerance = {t}: adaptive entries have samples = 0",
+                        self.samples
+                    ));
+                }
+            }
+            None if self.samples < 8 => {
+                return Err(format!(
+                    "samples = {} (a table uses at least 8)",
+                    self.samples
+                ));
+            }
+            None => {}
         }
         Ok(())
     }
@@ -399,14 +446,14 @@ pub(crate) struct TableRow {
 }
 
 /// Computes the rows θ_i for which `keep(θ_i index)` holds [TSBRM §4.3: the body integral
-/// of IL18 eq. 13 without its K_d prefactor, on the (θ_i, θ_o, Δφ) grid]. Each entry uses
-/// the same shared microfacet set, so any subset of rows is computed exactly as in the
-/// full table.
+/// of IL18 eq. 13 without its K_d prefactor, on the (θ_i, θ_o, Δφ) grid]. Sampled entries
+/// use the same shared microfacet set, adaptive entries are computed independently, so
+/// any subset of rows is computed exactly as in the full table.
 pub(crate) fn compute_rows(
     lobe: &SpecularLobe,
     ni: f64,
     step_deg: f64,
-    samples: usize,
+    entries: TableEntries,
     keep: &(dyn Fn(usize) -> bool + Sync),
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> ParamResult<(TableGrid, Vec<TableRow>)> {
@@ -418,7 +465,11 @@ pub(crate) fn compute_rows(
         ));
     }
     let intervals = check_step(step_deg).map_err(ParamError::Invalid)? as f64;
-    if samples < 8 {
+    let (samples, tolerance) = match entries {
+        TableEntries::Samples(n) => (n, None),
+        TableEntries::Adaptive { tolerance } => (0, Some(check_tolerance(tolerance)?)),
+    };
+    if tolerance.is_none() && samples < 8 {
         return Err(ParamError::OutOfRange {
             name: "samples".into(),
             value: samples as f64,
@@ -430,9 +481,13 @@ pub(crate) fn compute_rows(
     let n_phi = 2 * intervals as usize + 1;
     // The shared microfacet set: 8 rotations of a Hammersley set, with D cos / pdf.
     const ROT: usize = 8;
-    let per = (samples / ROT).max(1) as u32;
+    let per = if tolerance.is_some() {
+        0
+    } else {
+        (samples / ROT).max(1) as u32
+    };
     let mut rng = Pcg32::new(mix_seed(0x7ab1e, samples as u64), 3);
-    let normals: Vec<Vec<(Vec3, f64)>> = (0..ROT)
+    let normals: Vec<Vec<(Vec3, f64)>> = (0..if tolerance.is_some() { 0 } else { ROT })
         .map(|_| {
             let shift = rng.next_2d();
             (0..per)
@@ -461,6 +516,24 @@ pub(crate) fn compute_rows(
         .map(|ti| {
             let i = dir(ti, 0);
             let mut out = Vec::with_capacity((n_theta - ti) * n_phi);
+            if let Some(tol) = tolerance {
+                // [IL18 eq. 13] to the tolerance, with its error estimate: the adaptive
+                // quadrature of `evaluation = "quadrature"`.
+                let t = |c: f64| 1.0 - fresnel_dielectric(c.abs(), ni);
+                for to in ti..n_theta {
+                    for ph in 0..n_phi {
+                        let o = dir(to, ph);
+                        let q = integral.integrate(i, o, tol, |m| t(i.dot(m)) * t(o.dot(m)));
+                        out.push((to, ph, q.value, q.error));
+                    }
+                }
+                let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(d, total_rows);
+                return TableRow {
+                    theta_i: ti,
+                    entries: out,
+                };
+            }
             // T(i·m) per normal, computed once for the row.
             let ti_vals: Vec<Vec<f64>> = normals
                 .iter()
@@ -514,7 +587,145 @@ pub(crate) fn compute_rows(
             n_theta,
             n_phi,
             samples: per as usize * ROT,
+            tolerance,
         },
         rows,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::rng::Pcg32;
+    use crate::microfacet::specular_lobe::NormalSampling;
+    use crate::microfacet::{Beckmann, Ggx, Masking, Ndf};
+    use crate::models::il::il_table_part::{merge_table_parts, TablePart};
+
+    fn lobes() -> Vec<SpecularLobe> {
+        vec![
+            SpecularLobe::new(
+                Ndf::Beckmann(Beckmann::isotropic(0.4).unwrap()),
+                Masking::SmithCorrelated,
+                NormalSampling::Visible,
+            )
+            .unwrap(),
+            SpecularLobe::new(
+                Ndf::Ggx(Ggx::isotropic(0.8).unwrap()),
+                Masking::VCavity,
+                NormalSampling::Visible,
+            )
+            .unwrap(),
+        ]
+    }
+
+    #[test]
+    fn adaptive_entries_meet_their_tolerance_against_independent_references() {
+        // A 30° table (4 × 4 × 7 grid) at tolerance 1e-4: every entry against the same
+        // quadrature at 1e-9 (within the tolerance and within its own estimate), and against
+        // the independent randomized QMC estimate with 2^20 normals (within 4 standard
+        // errors plus the tolerance).
+        let ni = 1.5;
+        let tol = 1e-4;
+        for lobe in lobes() {
+            let t = BodyTable::build_with(
+                &lobe,
+                ni,
+                30.0,
+                TableEntries::Adaptive { tolerance: tol },
+                &|_, _| {},
+            )
+            .unwrap();
+            assert_eq!((t.tolerance, t.samples), (Some(tol), 0));
+            assert!(t.max_stderr <= tol, "{}", t.max_stderr);
+            let integral = MicrofacetIntegral::new(lobe.ndf.clone(), lobe.masking).unwrap();
+            let tr = |c: f64| 1.0 - fresnel_dielectric(c.abs(), ni);
+            let (n_theta, n_phi) = (t.n_theta, t.n_phi);
+            let step = 30f64.to_radians();
+            let dir = |k: usize, p: usize| {
+                spherical_direction((k as f64 * step).min(0.5 * PI - 1e-6), p as f64 * step)
+            };
+            let mut worst = 0.0f64;
+            for ti in 0..n_theta - 1 {
+                for to in ti..n_theta - 1 {
+                    for ph in [0, 2, 4, 6] {
+                        let (i, o) = (dir(ti, 0), dir(to, ph));
+                        let v = t.values()[(ti * n_theta + to) * n_phi + ph];
+                        let h = |m: Vec3| tr(i.dot(m)) * tr(o.dot(m));
+                        let r = integral.integrate(i, o, 1e-9, h);
+                        let q = integral.integrate(i, o, tol, h);
+                        let what =
+                            format!("{} θ {ti} {to} φ {ph}: {v} vs {r:?}", lobe.ndf.describe());
+                        assert_eq!(v, q.value, "{what}");
+                        let err = (v - r.value).abs();
+                        assert!(err <= tol * r.value + r.error, "{what}");
+                        assert!(err <= q.error + r.error, "{what}: estimate {q:?}");
+                        worst = worst.max(err / r.value);
+                        let (m, se) =
+                            integral.estimate(i, o, 1 << 20, &mut Pcg32::new(3, ti as u64), h);
+                        assert!(
+                            (m - v).abs() <= 4.0 * se + tol * v,
+                            "{what}: QMC {m} ± {se}"
+                        );
+                    }
+                }
+            }
+            println!(
+                "{}: largest relative error {worst:.1e}",
+                lobe.ndf.describe()
+            );
+        }
+    }
+
+    #[test]
+    fn adaptive_tables_round_trip_and_merge_from_parts() {
+        let lobe = &lobes()[0];
+        let entries = TableEntries::Adaptive { tolerance: 1e-3 };
+        let t = BodyTable::build_with(lobe, 1.3, 30.0, entries, &|_, _| {}).unwrap();
+        let back = BodyTable::from_bytes(&t.to_bytes(), "t").unwrap();
+        assert_eq!(back.values(), t.values());
+        assert_eq!((back.tolerance, back.samples), (Some(1e-3), 0));
+        assert_eq!(back.max_stderr, t.max_stderr);
+        let parts: Vec<TablePart> = (0..2)
+            .map(|k| {
+                let p = TablePart::build_with(lobe, 1.3, 30.0, entries, k, 2, &|_, _| {}).unwrap();
+                TablePart::from_bytes(&p.to_bytes(), "part").unwrap()
+            })
+            .collect();
+        assert_eq!(merge_table_parts(&parts).unwrap().to_bytes(), t.to_bytes());
+        // A part of a sampled table does not merge with adaptive parts.
+        let sampled = TablePart::build(lobe, 1.3, 30.0, 64, 1, 2, &|_, _| {}).unwrap();
+        assert!(merge_table_parts(&[parts[0].clone(), sampled])
+            .unwrap_err()
+            .contains("another table"));
+        // Tolerances outside the range are refused, naming it.
+        for bad in [0.0, 0.5, f64::NAN] {
+            let e = BodyTable::build_with(
+                lobe,
+                1.3,
+                30.0,
+                TableEntries::Adaptive { tolerance: bad },
+                &|_, _| {},
+            )
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("tolerance"), "{e}");
+        }
+        // A header with a tolerance out of range, or with samples, is refused.
+        let text = String::from_utf8_lossy(&t.to_bytes()).to_string();
+        assert!(text.contains("tolerance = 1e-3"), "{text}");
+        let mut g = TableGrid {
+            ni: 1.3,
+            distribution: t.distribution.clone(),
+            masking: t.masking.clone(),
+            step_deg: 30.0,
+            n_theta: 4,
+            n_phi: 7,
+            samples: 0,
+            tolerance: Some(0.5),
+        };
+        assert!(g.validate().unwrap_err().contains("tolerance"));
+        g.tolerance = Some(1e-3);
+        g.samples = 64;
+        assert!(g.validate().unwrap_err().contains("samples = 0"));
+    }
 }

@@ -13,13 +13,14 @@
 //! | bytes | content |
 //! |---|---|
 //! | 4 | u32 length L of the header |
-//! | L | UTF-8 TOML header: `model = "il-body-part"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples`, `part`, `parts` |
+//! | L | UTF-8 TOML header: `model = "il-body-part"`, `ni`, `distribution`, `masking`, `step_deg`, `n_theta`, `n_phi`, `samples` (0 for adaptive entries), `tolerance` (adaptive entries only), `part`, `parts` |
 //! | 4 | u32 number of rows R |
-//! | R × (8 + E·24) | per row: u32 θ_i index, u32 entry count E, then E × (u32 θ_o index, u32 φ index, f64 value, f64 standard error) |
+//! | R × (8 + E·24) | per row: u32 θ_i index, u32 entry count E, then E × (u32 θ_o index, u32 φ index, f64 value, f64 standard error or error estimate) |
 
-use super::il_table::{compute_rows, BodyTable, TableError, TableGrid, TableRow};
+use super::il_table::{compute_rows, tolerance_line, BodyTable, TableError, TableGrid, TableRow};
 use crate::error::ParamResult;
 use crate::limits;
+use crate::microfacet::integral::TableEntries;
 use crate::microfacet::specular_lobe::SpecularLobe;
 use std::path::Path;
 
@@ -54,13 +55,34 @@ impl TablePart {
         parts: u32,
         progress: &(dyn Fn(usize, usize) + Sync),
     ) -> ParamResult<TablePart> {
+        Self::build_with(
+            lobe,
+            ni,
+            step_deg,
+            TableEntries::Samples(samples),
+            part,
+            parts,
+            progress,
+        )
+    }
+
+    /// [`TablePart::build`] with sampled or adaptive entries (see [`BodyTable::build_with`]).
+    pub fn build_with(
+        lobe: &SpecularLobe,
+        ni: f64,
+        step_deg: f64,
+        entries: TableEntries,
+        part: u32,
+        parts: u32,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> ParamResult<TablePart> {
         if parts == 0 || part >= parts {
             return Err(crate::error::ParamError::Invalid(format!(
                 "part {part}/{parts}: need 0 ≤ K < N"
             )));
         }
         let keep = move |t: usize| t % parts as usize == part as usize;
-        let (grid, rows) = compute_rows(lobe, ni, step_deg, samples, &keep, progress)?;
+        let (grid, rows) = compute_rows(lobe, ni, step_deg, entries, &keep, progress)?;
         Ok(TablePart {
             part,
             parts,
@@ -77,8 +99,8 @@ impl TablePart {
     fn header(&self) -> String {
         let g = &self.grid;
         format!(
-            "model = \"il-body-part\"\nni = {}\ndistribution = \"{}\"\nmasking = \"{}\"\nstep_deg = {}\nn_theta = {}\nn_phi = {}\nsamples = {}\npart = {}\nparts = {}\n",
-            g.ni, g.distribution, g.masking, g.step_deg, g.n_theta, g.n_phi, g.samples, self.part, self.parts
+            "model = \"il-body-part\"\nni = {}\ndistribution = \"{}\"\nmasking = \"{}\"\nstep_deg = {}\nn_theta = {}\nn_phi = {}\nsamples = {}\n{}part = {}\nparts = {}\n",
+            g.ni, g.distribution, g.masking, g.step_deg, g.n_theta, g.n_phi, g.samples, tolerance_line(g.tolerance), self.part, self.parts
         )
     }
 
@@ -157,6 +179,11 @@ impl TablePart {
             n_theta: count("n_theta")? as usize,
             n_phi: count("n_phi")? as usize,
             samples: count("samples")? as usize,
+            tolerance: match h.get("tolerance") {
+                None => None,
+                Some(toml::Value::Float(t)) => Some(*t),
+                Some(_) => return Err(bad("header: `tolerance` must be a number".into())),
+            },
         };
         grid.validate().map_err(|m| bad(format!("header: {m}")))?;
         let (part, parts) = (count("part")?, count("parts")?);

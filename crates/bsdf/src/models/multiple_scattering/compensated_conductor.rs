@@ -185,6 +185,10 @@ impl OpaqueBsdf for CompensatedConductor {
         })
     }
 
+    fn albedo_excess(&self) -> f64 {
+        super::albedo_tables::COMPENSATION_ERROR
+    }
+
     fn lobe_width(&self) -> f64 {
         self.single.lobe_width()
     }

@@ -574,6 +574,10 @@ impl Bsdf for CompensatedDielectric {
         })
     }
 
+    fn albedo_excess(&self) -> f64 {
+        super::albedo_tables::COMPENSATION_ERROR
+    }
+
     fn lobe_width(&self) -> f64 {
         self.single.lobe_width()
     }

@@ -6,9 +6,10 @@
 //!   proxy density;
 //! - [`albedo_tables`]: directional albedos of the single-scattering lobes, shared by the
 //!   energy-compensated [`compensated_conductor`] and [`compensated_dielectric`] [KC17]
-//!   (and the walk models' proxy); [`albedo_row`]: a table's row at a material's α, what
-//!   those models read per call.
+//!   (and the walk models' proxy), their entries integrated by [`albedo_quadrature`];
+//!   [`albedo_row`]: a table's row at a material's α, what those models read per call.
 
+pub mod albedo_quadrature;
 pub mod albedo_row;
 pub mod albedo_tables;
 pub mod compensated_conductor;

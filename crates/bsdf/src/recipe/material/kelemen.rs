@@ -7,6 +7,7 @@ use crate::error::{ParamError, ParamResult};
 use crate::fresnel::Fresnel;
 use crate::math::spectrum::Spectrum;
 use crate::microfacet::half_vector_density::HalfVectorDensity;
+use crate::microfacet::integral::{check_tolerance_named, TableEntries};
 use crate::models::Kelemen;
 use crate::recipe::params::Params;
 use std::sync::Arc;
@@ -18,6 +19,7 @@ pub(super) const KELEMEN_KEYS: &[&str] = &[
     "ior",
     "kd",
     "table_samples",
+    "table_tolerance",
 ];
 
 pub(super) fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
@@ -37,12 +39,26 @@ pub(super) fn parse_kelemen(p: &Params) -> ParamResult<MaterialRecipe> {
     let density = HalfVectorDensity::new(name, rough)?;
     let ior = check_ior(p.f64_or("ior", 1.5)?)?;
     let kd = p.spectrum("kd")?.unwrap_or(Spectrum::splat(0.5));
-    let samples = p.count("table_samples")?.unwrap_or(16384);
+    // The albedo table's entries: QMC (`table_samples`, the default) or adaptive quadrature
+    // to a relative tolerance (`table_tolerance`).
+    let entries = match (p.count("table_samples")?, p.f64("table_tolerance")?) {
+        (Some(_), Some(_)) => {
+            return Err(ParamError::Invalid(
+                "`table_samples` (QMC entries) and `table_tolerance` (adaptive entries) are \
+                 exclusive: give one"
+                    .into(),
+            ))
+        }
+        (None, Some(t)) => TableEntries::Adaptive {
+            tolerance: check_tolerance_named("table_tolerance", t)?,
+        },
+        (n, None) => TableEntries::Samples(n.unwrap_or(16384)),
+    };
     p.finish(&keys(KELEMEN_KEYS, false))?;
-    Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::new(
+    Ok(MaterialRecipe::Kelemen(Arc::new(Kelemen::with_entries(
         density,
         Fresnel::Dielectric { eta: ior },
         kd,
-        samples,
+        entries,
     )?)))
 }

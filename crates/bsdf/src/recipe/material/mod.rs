@@ -484,6 +484,7 @@ mod tests {
             r#"{type = "dielectric", alpha = 0.2, sampling = "widened"}"#,
             r#"{type = "kelemen", alpha = 0.3, kd = 0.8, table_samples = 256}"#,
             r#"{type = "kelemen", distribution = "phong", exponent = 40, table_samples = 256}"#,
+            r#"{type = "kelemen", alpha = 0.3, table_tolerance = 1e-5}"#,
         ] {
             let b = build(s).unwrap_or_else(|e| panic!("{s}: {e}"));
             assert!(!b.describe().is_empty());
@@ -520,6 +521,31 @@ mod tests {
             c.set_scalar("alpha", 0.2).is_err(),
             "a smooth conductor has no roughness to texture"
         );
+    }
+
+    #[test]
+    fn kelemen_table_tolerance_is_validated() {
+        for (s, want) in [
+            (
+                r#"{type = "kelemen", alpha = 0.3, table_tolerance = 0.5}"#,
+                "table_tolerance",
+            ),
+            (
+                r#"{type = "kelemen", alpha = 0.3, table_tolerance = 0}"#,
+                "<= 0.1",
+            ),
+            (
+                r#"{type = "kelemen", alpha = 0.3, table_tolerance = nan}"#,
+                "table_tolerance",
+            ),
+            (
+                r#"{type = "kelemen", alpha = 0.3, table_tolerance = 1e-4, table_samples = 256}"#,
+                "exclusive",
+            ),
+        ] {
+            let e = build(s).err().unwrap_or_else(|| panic!("{s}")).to_string();
+            assert!(e.contains(want), "{s}: {e}");
+        }
     }
 
     #[test]
