@@ -11,9 +11,9 @@
 //! argument's size for the usual angles and inlines into its caller.
 
 /// π/2 in three parts (fdlibm's `pio2_1`, `pio2_2`, `pio2_3`).
-const PIO2_1: f64 = 1.570_796_326_734_125_614_17e+00;
-const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
-const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
+const PIO2_1: f64 = 1.5707963267341256;
+const PIO2_2: f64 = 6.077100506303966e-11;
+const PIO2_3: f64 = 2.0222662487111665e-21;
 /// Beyond this |x| the reduction's k·part products are no longer exact.
 const REDUCTION_LIMIT: f64 = 1_647_099.0; // ≈ 2²⁰ π/2
 
@@ -46,12 +46,12 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 /// sin r for |r| ≤ π/4 [fdlibm `__kernel_sin`, without its tail term].
 #[inline(always)]
 fn kernel_sin(r: f64) -> f64 {
-    const S1: f64 = -1.666_666_666_666_663_243_48e-01;
-    const S2: f64 = 8.333_333_333_322_489_461_24e-03;
-    const S3: f64 = -1.984_126_982_985_794_931_34e-04;
-    const S4: f64 = 2.755_731_370_707_006_767_89e-06;
-    const S5: f64 = -2.505_076_025_340_686_341_95e-08;
-    const S6: f64 = 1.589_690_995_211_550_102_21e-10;
+    const S1: f64 = -0.16666666666666632;
+    const S2: f64 = 0.00833333333332249;
+    const S3: f64 = -0.0001984126982985795;
+    const S4: f64 = 2.7557313707070068e-06;
+    const S5: f64 = -2.5050760253406863e-08;
+    const S6: f64 = 1.58969099521155e-10;
     let z = r * r;
     let p = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
     r + r * z * (S1 + z * p)
@@ -61,12 +61,12 @@ fn kernel_sin(r: f64) -> f64 {
 /// fdlibm does so that its rounding error is not amplified.
 #[inline(always)]
 fn kernel_cos(r: f64) -> f64 {
-    const C1: f64 = 4.166_666_666_666_660_190_37e-02;
-    const C2: f64 = -1.388_888_888_887_410_957_49e-03;
-    const C3: f64 = 2.480_158_728_947_672_941_78e-05;
-    const C4: f64 = -2.755_731_435_139_066_330_35e-07;
-    const C5: f64 = 2.087_572_321_298_174_827_90e-09;
-    const C6: f64 = -1.135_964_755_778_819_482_65e-11;
+    const C1: f64 = 0.0416666666666666;
+    const C2: f64 = -0.001388888888887411;
+    const C3: f64 = 2.480158728947673e-05;
+    const C4: f64 = -2.7557314351390663e-07;
+    const C5: f64 = 2.087572321298175e-09;
+    const C6: f64 = -1.1359647557788195e-11;
     let z = r * r;
     let p = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
     let hz = 0.5 * z;
