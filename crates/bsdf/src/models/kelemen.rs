@@ -10,7 +10,8 @@
 //! a_s(θ) is tabulated when the material is built (91 angles, 0°…90°, linear interpolation),
 //! each entry either by the Monte Carlo quadrature of KSK01 §2.1.5 with the specular
 //! sampler — randomized QMC with `table_samples` points in 8 rotations, whose standard
-//! error is kept — or, with `table_tolerance`, by adaptive quadrature over the half-vector
+//! error is kept — or, with `table_tolerance` (the material syntax's default, 1e-4), by
+//! adaptive quadrature over the half-vector
 //! hemisphere (a_s(θ) = ∫ P_H(H) F(H·V) (L·n)/(H·V) dω_H, KSK01 eq. 3 with
 //! dω_L = 4 (H·V) dω_H, cut where L crosses the horizon; see
 //! `albedo_quadrature::reflection_integral_adaptive`) to that relative tolerance, whose error estimate is
@@ -32,8 +33,8 @@
 //! | `exponent` | Phong exponent n | [0, 1e7] | required for phong |
 //! | `ior` | index of the Fresnel term (dielectric) | > 1 | 1.5 |
 //! | `kd` | matte colour k (number or RGB) | [0, 1] | 0.5 |
-//! | `table_samples` | QMC samples per albedo-table entry | ≥ 64 | 16384 |
-//! | `table_tolerance` | relative tolerance of adaptive albedo-table entries (instead of `table_samples`) | [1e-12, 0.1] | — |
+//! | `table_tolerance` | relative tolerance of adaptive albedo-table entries | [1e-12, 0.1] | 1e-4 |
+//! | `table_samples` | QMC samples per albedo-table entry (instead of `table_tolerance`) | ≥ 64 | — |
 
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
 use crate::checks::{check_min_count, check_reflectance};
