@@ -6,6 +6,7 @@ use crate::errors::{os_error, value_error};
 use crate::interrupt;
 use crate::render::{film_array, options, scene_arg};
 use crate::toml_value::table_from_py;
+use facette_bsdf::microfacet::integral::{check_tolerance, TableEntries};
 use facette_bsdf::models::il::il_table::BodyTable;
 use facette_bsdf::models::il::il_table_part::{merge_table_parts as merge_tables, TablePart};
 use facette_bsdf::models::il::interfaced_lambertian::{BodyEvaluation, Scattering};
@@ -159,6 +160,18 @@ fn il_lobe(
     })
 }
 
+/// The entries of a table: `samples` QMC microfacets each, or adaptive quadrature to
+/// `tolerance` (checked against the range of the `tolerance` key) when it is given — what
+/// `facette tabulate --samples / --tolerance` chooses.
+fn table_entries(samples: usize, tolerance: Option<f64>) -> PyResult<TableEntries> {
+    Ok(match tolerance {
+        Some(t) => TableEntries::Adaptive {
+            tolerance: check_tolerance(t).map_err(value_error)?,
+        },
+        None => TableEntries::Samples(samples),
+    })
+}
+
 /// Checks that `material` can be tabulated (a rough IL material): the driver-side check
 /// of a distributed table.
 #[pyfunction]
@@ -169,7 +182,7 @@ pub fn check_table_material(material: &Bound<'_, PyAny>) -> PyResult<()> {
 /// Tabulates the body term of an IL material (`facette tabulate`); returns the `.fctab`
 /// bytes and writes them to `output` when given.
 #[pyfunction]
-#[pyo3(signature = (material, step = 5.0, samples = 10_000, output = None, progress = None))]
+#[pyo3(signature = (material, step = 5.0, samples = 10_000, output = None, progress = None, tolerance = None))]
 pub fn tabulate<'py>(
     py: Python<'py>,
     material: &Bound<'py, PyAny>,
@@ -177,10 +190,12 @@ pub fn tabulate<'py>(
     samples: usize,
     output: Option<std::path::PathBuf>,
     progress: Option<Py<PyAny>>,
+    tolerance: Option<f64>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let (lobe, ni) = il_lobe(material)?;
+    let entries = table_entries(samples, tolerance)?;
     let bytes = interrupt::run_all(py, "facette.tabulate", progress, move |c| {
-        let t = BodyTable::build(&lobe, ni, step, samples, &|d, t| {
+        let t = BodyTable::build_with(&lobe, ni, step, entries, &|d, t| {
             c.progress(d as u64, t as u64)
         })
         .map_err(value_error)?;
@@ -194,7 +209,8 @@ pub fn tabulate<'py>(
 
 /// Part `part` of `parts` of a table (`facette tabulate --part`); returns `.fctpart` bytes.
 #[pyfunction]
-#[pyo3(signature = (material, part, parts, step = 5.0, samples = 10_000, progress = None))]
+#[pyo3(signature = (material, part, parts, step = 5.0, samples = 10_000, progress = None, tolerance = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn tabulate_part<'py>(
     py: Python<'py>,
     material: &Bound<'py, PyAny>,
@@ -203,10 +219,12 @@ pub fn tabulate_part<'py>(
     step: f64,
     samples: usize,
     progress: Option<Py<PyAny>>,
+    tolerance: Option<f64>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let (lobe, ni) = il_lobe(material)?;
+    let entries = table_entries(samples, tolerance)?;
     let bytes = interrupt::run_all(py, "facette.tabulate_part", progress, move |c| {
-        let p = TablePart::build(&lobe, ni, step, samples, part, parts, &|d, t| {
+        let p = TablePart::build_with(&lobe, ni, step, entries, part, parts, &|d, t| {
             c.progress(d as u64, t as u64)
         })
         .map_err(value_error)?;

@@ -75,3 +75,6 @@ def test_dict_scenes_and_materials_travel_to_the_workers(tiny_scene):
                                   facette.render_in_parts(scene, 2, seed=1))
     il = facette.Material({"type": "il", "ni": 1.4, "distribution": "beckmann", "alpha": 0.5})
     assert distributed.tabulate(il, 2, step=30, samples=64, progress=False) == facette.tabulate(il, step=30, samples=64)
+    assert distributed.tabulate(il, 2, step=30, tolerance=1e-3, progress=False) == facette.tabulate(
+        il, step=30, tolerance=1e-3
+    )

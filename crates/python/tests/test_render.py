@@ -45,6 +45,24 @@ def test_tables_split_and_merge_to_the_same_bytes(tmp_path):
         facette.tabulate('{type = "lambert"}')
 
 
+def test_adaptive_tables_split_and_merge_and_check_their_tolerance(tmp_path):
+    # `tolerance`: deterministic adaptive entries (`facette tabulate --tolerance`), written in
+    # the header; parts merge into the same bytes; the table agrees with the sampled one
+    # within the sampled one's standard errors.
+    m = '{type = "il", ni = 1.4, distribution = "beckmann", alpha = 0.5}'
+    full = facette.tabulate(m, step=30, tolerance=1e-4)
+    assert b"tolerance = 1e-4" in full and full == facette.tabulate(m, step=30, tolerance=1e-4)
+    parts = [facette.tabulate_part(m, k, 2, step=30, tolerance=1e-4) for k in range(2)]
+    assert facette.merge_table_parts(parts) == full
+    with pytest.raises(ValueError, match="exclusive"):
+        facette.tabulate(m, step=30, samples=64, tolerance=1e-4)
+    for bad in (-1.0, 0.5, float("nan")):
+        with pytest.raises(ValueError, match="tolerance"):
+            facette.tabulate(m, step=30, tolerance=bad)
+    with pytest.raises(ValueError, match="tolerance"):
+        facette.tabulate(m, step=30, tolerance="1e-4")
+
+
 def test_render_errors(tmp_path):
     with pytest.raises(OSError, match="cannot read the scene file"):
         facette.render(tmp_path / "missing.toml")

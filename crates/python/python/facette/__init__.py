@@ -408,18 +408,36 @@ def _material_arg(material):
 
 
 @_entry("facette.tabulate")
-def tabulate(material, step=5.0, samples=10_000, output=None, *, progress=False):
+def _table_entries(samples, tolerance):
+    """(samples, tolerance) for the extension: QMC entries (10 000 microfacets unless
+    ``samples`` says otherwise), or adaptive quadrature to ``tolerance``; not both."""
+    if tolerance is None:
+        return _count(10_000 if samples is None else samples, "samples", 1), None
+    if samples is not None:
+        raise ValueError("`samples` (QMC entries) and `tolerance` (adaptive entries) are exclusive: give one")
+    if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)):
+        raise ValueError(f"`tolerance` = {tolerance!r}: must be a number")
+    return 1, float(tolerance)
+
+
+@_entry("facette.tabulate")
+def tabulate(material, step=5.0, samples=None, output=None, *, tolerance=None, progress=False):
     """Tabulates an IL material's body term (``facette tabulate``); returns the ``.fctab``
-    bytes, also written to ``output`` when given. ``progress`` counts table rows."""
-    return _facette.tabulate(_material_arg(material), step, _count(samples, "samples", 1),
-                             None if output is None else _os.fspath(output), _progress(progress, "tabulate"))
+    bytes, also written to ``output`` when given. Entries are QMC estimates of ``samples``
+    microfacets (10 000 by default) or, with ``tolerance``, deterministic adaptive quadrature
+    to that relative tolerance (``--tolerance``). ``progress`` counts table rows."""
+    n, tol = _table_entries(samples, tolerance)
+    return _facette.tabulate(_material_arg(material), step, n,
+                             None if output is None else _os.fspath(output), _progress(progress, "tabulate"), tol)
 
 
 @_entry("facette.tabulate_part")
-def tabulate_part(material, part, parts, step=5.0, samples=10_000, *, progress=False):
-    """Part ``part`` of ``parts`` of a table (``facette tabulate --part``), as bytes."""
+def tabulate_part(material, part, parts, step=5.0, samples=None, *, tolerance=None, progress=False):
+    """Part ``part`` of ``parts`` of a table (``facette tabulate --part``), as bytes;
+    ``samples`` and ``tolerance`` as for ``tabulate``."""
+    n, tol = _table_entries(samples, tolerance)
     return _facette.tabulate_part(_material_arg(material), _count(part, "part"), _count(parts, "parts", 1), step,
-                                  _count(samples, "samples", 1), _progress(progress, "tabulate part"))
+                                  n, _progress(progress, "tabulate part"), tol)
 
 
 @_entry("facette.merge_table_parts")

@@ -117,10 +117,23 @@ def merge_render_parts(parts: Sequence[bytes], exposure: Optional[float] = ...) 
 def write_image(path: Path, image: ArrayLike, exposure: float = ...) -> None: ...
 def read_image(path: Path, linear: bool = ...) -> npt.NDArray[np.float32]: ...
 def tabulate(
-    material: MaterialSpec, step: float = ..., samples: int = ..., output: Optional[Path] = ..., *, progress: Progress = ...
+    material: MaterialSpec,
+    step: float = ...,
+    samples: Optional[int] = ...,
+    output: Optional[Path] = ...,
+    *,
+    tolerance: Optional[float] = ...,
+    progress: Progress = ...,
 ) -> bytes: ...
 def tabulate_part(
-    material: MaterialSpec, part: int, parts: int, step: float = ..., samples: int = ..., *, progress: Progress = ...
+    material: MaterialSpec,
+    part: int,
+    parts: int,
+    step: float = ...,
+    samples: Optional[int] = ...,
+    *,
+    tolerance: Optional[float] = ...,
+    progress: Progress = ...,
 ) -> bytes: ...
 def merge_table_parts(parts: Sequence[bytes], output: Optional[Path] = ...) -> bytes: ...
 def fit(

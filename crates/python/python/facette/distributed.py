@@ -78,10 +78,10 @@ def _render_task(scene, part, parts, spp, seed, threads, fault_dir, defines=None
         return _UserError(part, e)
 
 
-def _table_task(material, part, parts, step, samples, fault_dir):
+def _table_task(material, part, parts, step, samples, tolerance, fault_dir):
     try:
         _maybe_fail_once(fault_dir, "table", part)
-        return facette.tabulate_part(material, part, parts, step=step, samples=samples)
+        return facette.tabulate_part(material, part, parts, step=step, samples=samples, tolerance=tolerance)
     except (ValueError, OSError) as e:
         return _UserError(part, e)
 
@@ -157,8 +157,8 @@ def render(scene, parts, output=None, spp=None, seed=0, address=None, num_cpus=N
     return image
 
 
-def tabulate(material, parts, output=None, step=5.0, samples=10_000, address=None, num_cpus=None,
-             max_retries=3, progress=True, _fault_dir=None):
+def tabulate(material, parts, output=None, step=5.0, samples=None, address=None, num_cpus=None,
+             max_retries=3, progress=True, tolerance=None, _fault_dir=None):
     """Tabulates an IL material's body term in ``parts`` Ray tasks and merges the rows;
     returns the ``.fctab`` bytes (written to ``output`` when given), byte for byte those of
     ``facette.tabulate``. ``material``: a ``Material``, TOML inline table or dict, checked
@@ -169,9 +169,10 @@ def tabulate(material, parts, output=None, step=5.0, samples=10_000, address=Non
         material = material.toml
     # Checked here (a material that is not a rough IL one fails now, not in every task).
     facette._facette.check_table_material(material)
+    facette._table_entries(samples, tolerance)
     ray = _init(address, num_cpus)
     task = ray.remote(num_cpus=1, max_retries=max_retries, retry_exceptions=True)(_table_task)
-    refs = [task.remote(material, k, parts, step, samples, _fault_dir) for k in range(parts)]
+    refs = [task.remote(material, k, parts, step, samples, tolerance, _fault_dir) for k in range(parts)]
     results = _gather(ray, refs, "tabulate", progress)
     return facette.merge_table_parts(results, output)
 
@@ -190,7 +191,9 @@ def main(argv=None):
     t.add_argument("--parts", type=int, required=True)
     t.add_argument("-o", "--output", required=True)
     t.add_argument("--step", type=float, default=5.0)
-    t.add_argument("--samples", type=int, default=10_000)
+    entries = t.add_mutually_exclusive_group()
+    entries.add_argument("--samples", type=int)
+    entries.add_argument("--tolerance", type=float, help="adaptive entries to this relative tolerance")
     for s in (r, t):
         s.add_argument("--address", help="Ray cluster address (default: start a local Ray)")
         s.add_argument("--num-cpus", type=int, help="CPUs of the local Ray instance")
@@ -206,7 +209,7 @@ def main(argv=None):
                          max_retries=a.max_retries, progress=not a.quiet)
             print(f"{a.output}: {img.shape[1]}×{img.shape[0]}, {a.parts} parts merged in {time.time() - start:.2f} s")
         else:
-            tabulate(a.material, a.parts, a.output, step=a.step, samples=a.samples, address=a.address,
+            tabulate(a.material, a.parts, a.output, step=a.step, samples=a.samples, tolerance=a.tolerance, address=a.address,
                      num_cpus=a.num_cpus, max_retries=a.max_retries, progress=not a.quiet)
             print(f"{a.output}: {a.parts} parts merged in {time.time() - start:.2f} s")
     except (ValueError, OSError) as e:

@@ -23,10 +23,11 @@ def tabulate(
     parts: int,
     output: Optional[Path] = ...,
     step: float = ...,
-    samples: int = ...,
+    samples: Optional[int] = ...,
     address: Optional[str] = ...,
     num_cpus: Optional[int] = ...,
     max_retries: int = ...,
     progress: bool = ...,
+    tolerance: Optional[float] = ...,
 ) -> bytes: ...
 def main(argv: Optional[Sequence[str]] = ...) -> int: ...
