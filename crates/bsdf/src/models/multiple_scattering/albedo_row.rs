@@ -64,6 +64,8 @@ pub struct AlbedoRow {
     e: SquareNodes<MU_NODES>,
     /// E_avg = 2 ∫ E μ dμ of the interpolant.
     average: f64,
+    /// 1/(π (1 − E_avg)), 0 when nothing is missing: the lobe density's normalization.
+    density_norm: f64,
     /// The cumulative ∫ (1 − E) μ dμ over the μ intervals.
     cumulative: [f64; MU_NODES - 1],
 }
@@ -72,9 +74,15 @@ impl AlbedoRow {
     /// The row of node values `e`, with its average and cumulative masses (the blends of the
     /// table's, which are linear in E).
     pub(super) fn new(e: [f64; MU_NODES], average: f64, cumulative: [f64; MU_NODES - 1]) -> Self {
+        let missing = 1.0 - average;
         AlbedoRow {
             e: SquareNodes::new(e),
             average,
+            density_norm: if missing > 1e-12 {
+                INV_PI / missing
+            } else {
+                0.0
+            },
             cumulative,
         }
     }
@@ -102,11 +110,10 @@ impl AlbedoRow {
     /// missing. The table's `lobe_density(μ, α)`.
     #[inline(always)]
     pub fn lobe_density(&self, mu: f64) -> f64 {
-        let missing = 1.0 - self.average;
-        if !(missing > 1e-12) || mu <= 0.0 {
+        if mu <= 0.0 {
             return 0.0;
         }
-        (self.missing(mu) * mu * INV_PI / missing).max(0.0)
+        self.missing(mu) * mu * self.density_norm
     }
 
     /// Draws μ with density 2 (1 − E(μ)) μ / (1 − E_avg) on [0, 1]: an interval by its

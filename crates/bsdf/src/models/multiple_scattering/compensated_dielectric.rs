@@ -126,9 +126,11 @@ struct Side {
     /// s_A(μ) at the material's α with c_A applied: 1 − c_A (1 − s), c_A the factor on
     /// 1 − s that makes the averages reciprocal between table rows.
     share: SquareNodes<SHARE_NODES>,
-    /// ā_A and ū_A: the averages of the compensation's reflectance and transmittance.
-    reflected: f64,
+    /// ū_A: the average of the compensation's transmittance.
     transmitted: f64,
+    /// 1/(π ā_A) and 1/(π ū_A), 0 where the average is below 1e-12 (no lobe).
+    reflected_norm: f64,
+    transmitted_norm: f64,
 }
 
 #[derive(Clone, Debug)]
@@ -336,6 +338,15 @@ fn retarget(table: &AlbedoTable, alpha: f64, share: &mut [f64; SHARE_NODES], tar
     *share = scaled(0.5 * (lo + hi));
 }
 
+/// 1/(π a) for a lobe of average a, 0 when the lobe has (almost) nothing to return.
+fn lobe_norm(average: f64) -> f64 {
+    if average > 1e-12 {
+        INV_PI / average
+    } else {
+        0.0
+    }
+}
+
 impl CompensatedDielectric {
     /// Adds the compensation lobes to a rough dielectric (Beckmann or GGX).
     pub fn new(single: RoughDielectric) -> ParamResult<Self> {
@@ -377,8 +388,9 @@ impl CompensatedDielectric {
                 row: table.row_at(alpha),
                 table,
                 share,
-                reflected,
                 transmitted,
+                reflected_norm: lobe_norm(reflected),
+                transmitted_norm: lobe_norm(transmitted),
             }
         };
         Ok(CompensatedDielectric {
@@ -441,15 +453,9 @@ impl CompensatedDielectric {
         let (ao, uo) = self.reflected_and_transmitted(o);
         let b = self.side(o);
         if i.z * o.z > 0.0 {
-            if !(b.reflected > 1e-12) {
-                return Spectrum::ZERO;
-            }
-            self.reflect_tint * (ai * ao * INV_PI / b.reflected)
+            self.reflect_tint * (ai * ao * b.reflected_norm)
         } else {
-            if !(b.transmitted > 1e-12) {
-                return Spectrum::ZERO;
-            }
-            self.transmit_tint * (ui * uo * INV_PI / b.transmitted)
+            self.transmit_tint * (ui * uo * b.transmitted_norm)
         }
     }
 
