@@ -125,24 +125,40 @@ impl AlbedoRow {
         if !(mass > 0.0) {
             return None;
         }
-        let target = rng.next_f64() * mass;
-        let k = self.cumulative.partition_point(|&c| c <= target).min(last);
-        let (p, q) = (square_node::<MU_NODES>(k), square_node::<MU_NODES>(k + 1));
-        let e = self.e.values();
-        let (lp, lq) = (1.0 - e[k], 1.0 - e[k + 1]);
-        let top = lp.max(lq);
-        if !(top > 0.0) {
-            return None;
-        }
-        for _ in 0..200 {
-            let mu = (p * p + rng.next_f64() * (q * q - p * p)).sqrt();
-            let l = lp + (lq - lp) * (mu - p) / (q - p);
-            if rng.next_f64() * top < l {
-                return Some(mu);
-            }
-        }
-        None
+        sample_in_row(&self.cumulative, self.e.values(), rng)
     }
+}
+
+/// Draws μ from one tabulated row: an interval by the row's `cumulative` masses of
+/// (1 − E) μ, then μ ∝ μ on it by rejection against the linear 1 − E between the interval's
+/// nodes `e[k]`, `e[k + 1]` (acceptance at least ½) — the one sampler of
+/// [`AlbedoRow::sample_mu`] and [`AlbedoTable::sample_mu`].
+pub(super) fn sample_in_row(
+    cumulative: &[f64],
+    e: &[f64],
+    rng: &mut dyn RandomSource,
+) -> Option<f64> {
+    let last = MU_NODES - 2;
+    let target = rng.next_f64() * cumulative[last];
+    let k = cumulative.partition_point(|&c| c <= target).min(last);
+    let node = |k: usize| {
+        let x = k as f64 / (MU_NODES - 1) as f64;
+        x * x
+    };
+    let (p, q) = (node(k), node(k + 1));
+    let (lp, lq) = (1.0 - e[k], 1.0 - e[k + 1]);
+    let top = lp.max(lq);
+    if !(top > 0.0) {
+        return None;
+    }
+    for _ in 0..200 {
+        let mu = (p * p + rng.next_f64() * (q * q - p * p)).sqrt();
+        let l = lp + (lq - lp) * (mu - p) / (q - p);
+        if rng.next_f64() * top < l {
+            return Some(mu);
+        }
+    }
+    None
 }
 
 impl AlbedoTable {

@@ -531,23 +531,7 @@ impl AlbedoTable {
             j + 1
         };
         let cum = &self.cumulative[row * (MU_NODES - 1)..(row + 1) * (MU_NODES - 1)];
-        let target = rng.next_f64() * cum[last];
-        let k = cum.partition_point(|&c| c <= target).min(last);
-        let (p, q) = (mu_node(k), mu_node(k + 1));
-        let e = &self.e[row * MU_NODES..];
-        let (lp, lq) = (1.0 - e[k], 1.0 - e[k + 1]);
-        let top = lp.max(lq);
-        if !(top > 0.0) {
-            return None;
-        }
-        for _ in 0..200 {
-            let mu = (p * p + rng.next_f64() * (q * q - p * p)).sqrt();
-            let l = lp + (lq - lp) * (mu - p) / (q - p);
-            if rng.next_f64() * top < l {
-                return Some(mu);
-            }
-        }
-        None
+        super::albedo_row::sample_in_row(cum, &self.e[row * MU_NODES..(row + 1) * MU_NODES], rng)
     }
 
     /// Bytes of tabulated data.
