@@ -82,8 +82,11 @@
 //!
 //! **Accuracy.** The groove-orientation integral carries the adaptive rule's error estimate
 //! (tolerance relative to f_ms), as two integrals: the direct part ⟨E_o, J⁰⟩ (kinked where
-//! footprint ends cross, cheap: no operator) and the inter-reflections ⟨E_o, 𝒜J⁰⟩ (smooth,
-//! dear), each to the relative tolerance, their errors added. The per-segment estimate is
+//! footprint ends cross, cheap: no operator, cut at the azimuth breaks) and the
+//! inter-reflections ⟨E_o, 𝒜J⁰⟩ (smooth, dear, integrated without azimuth breaks: each
+//! would cost a 15-node segment, and their kinks are weak there), sharing one absolute error
+//! budget set by a pilot estimate of f_ms (see [`VCavityQuadrature::eval`]), their errors
+//! added. The per-segment estimate is
 //! the embedded |K15 − G7| ([`ErrorEstimate::Embedded`]) rather than QUADPACK's scaled one,
 //! which overstated the error 50–100× here; the footprint crossings are not given to the
 //! rule as breaks (locating them cost more than it saved), and the bisection floor catches
@@ -902,6 +905,35 @@ impl VCavityQuadrature {
         }
     }
 
+    /// The inter-reflection part of the groove density at (θ_m, φ_m), every channel, without
+    /// the groove weight D(m) cos θ_m sin θ_m (remembered per node in `state`).
+    fn galerkin_at(
+        &self,
+        theta: f64,
+        phi: f64,
+        i: Vec3,
+        o: Vec3,
+        state: &mut GalerkinState,
+    ) -> [f64; CHANNELS] {
+        let key = (theta.to_bits(), phi.to_bits());
+        if let Some(v) = state.memo.get(&key) {
+            return *v;
+        }
+        let op = match &state.current {
+            Some((k, op)) if *k == key.0 => op.clone(),
+            _ => {
+                let op = self.operator(theta);
+                state.current = Some((key.0, op.clone()));
+                op
+            }
+        };
+        self.trace_both(&op.wedge, i, o, phi, &mut state.scratch);
+        let mut out = [0.0; CHANNELS];
+        self.galerkin_density(&op, &mut state.scratch, &mut out);
+        state.memo.insert(key, out);
+        out
+    }
+
     /// The multiple-scattering BRDF f_ms(i, o) (orders ≥ 2, or exactly 2) and its estimated
     /// error, for upper-hemisphere i and o.
     ///
@@ -909,8 +941,13 @@ impl VCavityQuadrature {
     /// integrals [IL18 eq. 23]: the direct part (one body event; grey, no operator, cheap,
     /// but kinked wherever footprint ends cross, so its rule subdivides a lot) and the
     /// inter-reflections (smooth in the footprint ends through the C¹ cumulative tables,
-    /// dear per evaluation, few evaluations). Both are positive, so each to the relative
-    /// tolerance puts their sum within it; the reported error is the sum of their estimates.
+    /// dear per evaluation, few evaluations). Both share one absolute error budget,
+    /// 0.9 · tolerance · f_ms, f_ms estimated by a pilot pass (the first segments of both
+    /// integrals, no bisection, no azimuth breaks): the inter-reflections get half of it and
+    /// the direct part what they leave. Inner integrals then stop at an absolute target, so a
+    /// groove tilt that carries little of f_ms is not integrated to a relative tolerance of
+    /// its own. The reported error is the sum of the two estimates; `converged` says whether
+    /// it is within tolerance · f_ms.
     pub fn eval(&self, i: Vec3, o: Vec3) -> MsValue {
         if !(i.z > 0.0 && o.z > 0.0) {
             return MsValue {
@@ -932,6 +969,13 @@ impl VCavityQuadrature {
             max_segments: 200,
             estimate: ErrorEstimate::Embedded,
         };
+        // The inter-reflections are smooth in the footprint ends (C¹ cumulative tables):
+        // the footprints' kinks are too weak there to pay a 15-node segment each.
+        let whole_circle = |_| InnerRange {
+            lo: 0.0,
+            hi: PI,
+            breaks: Vec::new(),
+        };
         let azimuths = |theta| InnerRange {
             lo: 0.0,
             hi: PI,
@@ -944,46 +988,88 @@ impl VCavityQuadrature {
         };
         let mut scratch = Scratch::default();
         let dirac = self.specular_chains(i, o, &mut scratch);
-        let direct = integrate_2d(0.0, self.theta_max, &breaks, tol, azimuths, |theta, phi| {
+        let mut direct_at = |theta: f64, phi: f64| {
             let w = weight(theta, phi);
             if !(w > 0.0) {
                 return 0.0;
             }
             self.trace_both(&Wedge::new(theta), i, o, phi, &mut scratch);
             w * self.direct_density(&scratch)
-        });
-        let mut evaluations = direct.evaluations;
-        let mut converged = direct.converged;
-        for ch in 0..channels {
-            let mut current: Option<(u64, Arc<GrooveOperator>)> = None;
-            let q = integrate_2d(0.0, self.theta_max, &breaks, tol, azimuths, |theta, phi| {
-                let key = theta.to_bits();
-                let op = match &current {
-                    Some((k, op)) if *k == key => op.clone(),
-                    _ => {
-                        let op = self.operator(theta);
-                        current = Some((key, op.clone()));
-                        op
-                    }
-                };
-                let w = weight(theta, phi);
-                if !(w > 0.0) {
-                    return 0.0;
-                }
-                self.trace_both(&op.wedge, i, o, phi, &mut scratch);
-                let mut out = [0.0; CHANNELS];
-                self.galerkin_density(&op, &mut scratch, &mut out);
-                w * out[ch]
+        };
+        // The inter-reflections, all channels at once, remembered per node: the pilot's
+        // nodes are the first nodes of the final pass.
+        let mut state = GalerkinState::default();
+        let mut galerkin_at = |theta: f64, phi: f64, ch: usize| {
+            let w = weight(theta, phi);
+            if !(w > 0.0) {
+                return 0.0;
+            }
+            w * self.galerkin_at(theta, phi, i, o, &mut state)[ch]
+        };
+        // Pilot: one pass of the first segments (no bisection, no azimuth breaks) for an
+        // estimate of f_ms that sets the absolute error budget of both parts.
+        let single_pass = Tolerance {
+            max_segments: 1,
+            ..tol
+        };
+        let pilot_direct = integrate_2d(
+            0.0,
+            self.theta_max,
+            &breaks,
+            single_pass,
+            whole_circle,
+            &mut direct_at,
+        );
+        let mut evaluations = pilot_direct.evaluations;
+        // Per channel: the pilot of the inter-reflections sets the budget, of which they get
+        // half (their first nodes are the pilot's, remembered).
+        let mut budget = [0.0; CHANNELS];
+        let mut galerkin = [(0.0, 0.0); CHANNELS];
+        for (ch, (b, gal)) in budget
+            .iter_mut()
+            .zip(&mut galerkin)
+            .enumerate()
+            .take(channels)
+        {
+            let mut galerkin_part = |tol: Tolerance| {
+                integrate_2d(0.0, self.theta_max, &breaks, tol, whole_circle, |t, p| {
+                    galerkin_at(t, p, ch)
+                })
+            };
+            let pilot = galerkin_part(single_pass);
+            let cb = self.body_factor.0[ch];
+            // 0.9: room for the pilot's own error.
+            *b = 0.9 * self.tolerance * (cb * pilot_direct.value + pilot.value + dirac).abs();
+            let q = galerkin_part(Tolerance {
+                rel: 0.0,
+                abs: 0.5 * *b,
+                ..tol
             });
             evaluations += q.evaluations;
-            converged &= q.converged;
-            for c in 0..CHANNELS {
-                if channels == 1 || c == ch {
-                    let cb = self.body_factor.0[c];
-                    value.0[c] = (cb * direct.value + q.value + dirac) / o.z;
-                    error.0[c] = (cb * direct.error + q.error) / o.z;
-                }
-            }
+            *gal = (q.value, q.error);
+        }
+        if channels == 1 {
+            budget = [budget[0]; CHANNELS];
+            galerkin = [galerkin[0]; CHANNELS];
+        }
+        // The direct part (cheap, kinked) gets what the inter-reflections left, in units of
+        // c_b (it is grey).
+        let direct_budget = (0..CHANNELS)
+            .map(|c| (budget[c] - galerkin[c].1).max(0.0) / self.body_factor.0[c].max(1e-300))
+            .fold(f64::INFINITY, f64::min);
+        let part = Tolerance {
+            rel: 0.0,
+            abs: direct_budget.max(tol.abs),
+            ..tol
+        };
+        let direct = integrate_2d(0.0, self.theta_max, &breaks, part, azimuths, &mut direct_at);
+        evaluations += direct.evaluations;
+        let mut converged = true;
+        for (c, &(g, eg)) in galerkin.iter().enumerate() {
+            let cb = self.body_factor.0[c];
+            value.0[c] = (cb * direct.value + g + dirac) / o.z;
+            error.0[c] = (cb * direct.error + eg) / o.z;
+            converged &= error.0[c] <= self.tolerance * value.0[c].abs();
         }
         MsValue {
             value,
@@ -1126,6 +1212,14 @@ fn azimuth_breaks(theta: f64, i: Vec3, o: Vec3) -> Vec<f64> {
     out.sort_by(f64::total_cmp);
     out.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
     out
+}
+
+/// What [`VCavityQuadrature::galerkin_at`] keeps between nodes of one direction pair.
+#[derive(Default)]
+struct GalerkinState {
+    memo: HashMap<(u64, u64), [f64; CHANNELS]>,
+    current: Option<(u64, Arc<GrooveOperator>)>,
+    scratch: Scratch,
 }
 
 #[derive(Default)]
