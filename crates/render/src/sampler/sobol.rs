@@ -50,9 +50,12 @@ pub(crate) fn ceil_log2(n: u64) -> u32 {
 /// 32-bit fraction: Pascal's triangle mod 2, i.e. output digit i (of weight 2^-(i+1)) is set
 /// iff C(j, i) is odd, which by Lucas' theorem is iff the bits of i are a subset of those
 /// of j. With dimension 0 (the identity, the van der Corput sequence) it gives the
-/// (0, 2)-sequence in base 2 (Sobol 1967; Niederreiter 1992, §4.5).
+/// (0, 2)-sequence in base 2 (Sobol 1967; Niederreiter 1992, §4.5). The sampler applies it
+/// without the columns ([`sobol_1_reversed`]); the tests check that against them.
+#[cfg(test)]
 const SOBOL_1: [u32; 32] = pascal_mod2_columns();
 
+#[cfg(test)]
 const fn pascal_mod2_columns() -> [u32; 32] {
     let mut cols = [0u32; 32];
     let mut j = 0;
