@@ -60,6 +60,10 @@ fn bench_distribution(c: &mut Criterion, name: &str, d: Ndf) {
         batch(&mut g, "sample_visible", &dirs, &us, |v, _, u| {
             d.sample_visible(v, u).z
         });
+        // The map the fixed-rule albedo quadrature uses (GGX: Heitz's disk beside the caps).
+        batch(&mut g, "sample_visible_smooth", &dirs, &us, |v, _, u| {
+            d.sample_visible_smooth(v, u).z
+        });
         batch(&mut g, "pdf_visible", &dirs, &us, |v, m, _| {
             d.pdf_visible(v, m)
         });

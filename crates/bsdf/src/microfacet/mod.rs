@@ -72,6 +72,14 @@ pub trait Distribution: Send + Sync {
         self.pdf_normal(m)
     }
 
+    /// The same density as `sample_visible`, through a map from u that is smooth over the
+    /// whole unit square: for fixed-rule quadratures over u (the albedo tables' fixed
+    /// entries), where the sampler's own map may be faster but singular somewhere (GGX's
+    /// spherical caps at c = −v).
+    fn sample_visible_smooth(&self, v: Vec3, u: Vec2) -> Vec3 {
+        self.sample_visible(v, u)
+    }
+
     /// A representative slope-space width (α, or √2 σ for the Gaussian), used to size
     /// numerical integration and validation bins.
     fn typical_width(&self) -> f64;
@@ -202,6 +210,9 @@ impl Distribution for Ndf {
     #[inline]
     fn pdf_visible(&self, v: Vec3, m: Vec3) -> f64 {
         dispatch!(self, d => d.pdf_visible(v, m))
+    }
+    fn sample_visible_smooth(&self, v: Vec3, u: Vec2) -> Vec3 {
+        dispatch!(self, d => d.sample_visible_smooth(v, u))
     }
     fn typical_width(&self) -> f64 {
         dispatch!(self, d => d.typical_width())

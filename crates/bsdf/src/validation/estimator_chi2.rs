@@ -254,10 +254,9 @@ mod tests {
         let ctx = BsdfContext::RADIANCE;
         estimator_chi2_test(
             &SphereMap::standard(),
-            &EstimatorChi2Config {
-                samples: 200_000,
-                ..Default::default()
-            },
+            // 400,000 draws (the default): at 200,000 a 3 % bias sat at p ~ 5e-4 with some
+            // random streams (the chi-square excess grows with the draws).
+            &EstimatorChi2Config::default(),
             |_| true,
             |r| bsdf.sample(wo, &ctx, r).map(|s| (s.wi, s.weight.average())),
             |wi, r| scale * bsdf.eval(wo, wi, &ctx, r).average() * wi.z.abs(),

@@ -332,7 +332,7 @@ pub fn directional_albedo(
     }
     let rule = GaussLegendre::new(points);
     let sum = piecewise_integral_2d(&rule, |u1, u2| {
-        let m = ndf.sample_visible(o, Vec2::new(u1, u2));
+        let m = ndf.sample_visible_smooth(o, Vec2::new(u1, u2));
         estimator_weight(ndf, masking, fresnel, o, m)
     });
     (sum / g1).clamp(0.0, 1.0)
