@@ -178,7 +178,9 @@ impl HitLanes {
 struct Closest<'a> {
     geometry: &'a SceneGeometry,
     rays: &'a LaneRays,
-    best: [Option<PacketHit>; PACKET],
+    /// The caller's result, written in place (a by-value array here was copied out with
+    /// `memcpy` at every query).
+    best: &'a mut [Option<PacketHit>; PACKET],
     tri: [Option<TriangleRay>; PACKET],
 }
 
@@ -293,7 +295,7 @@ impl SceneGeometry {
         let mut q = Closest {
             geometry: self,
             rays,
-            best,
+            best: &mut best,
             tri: [None; PACKET],
         };
         match self.bvh.single_leaf() {
@@ -311,7 +313,7 @@ impl SceneGeometry {
                     });
             }
         }
-        q.best
+        best
     }
 
     /// The surface record of `ray`'s hit `hit` found by
