@@ -131,9 +131,7 @@ impl Ggx {
         let (ax, ay) = (R::splat(self.ax), R::splat(self.ay));
         let vh = LVec3::new(ax * v.x, ay * v.y, v.z.max(R::zero())).normalize();
         let z = (R::one() - u0) * (R::one() + vh.z) - vh.z;
-        let sin_theta = (R::one() - z * z).max(R::zero()).sqrt();
-        let (s, c) = (R::splat(TWO_PI) * u1).sin_cos();
-        let nh = LVec3::new(sin_theta * c + vh.x, sin_theta * s + vh.y, z + vh.z);
+        let nh = spherical_cap_halfway(vh, z, u1);
         LVec3::new(ax * nh.x, ay * nh.y, nh.z.max(R::splat(R::TINY))).normalize()
     }
 
@@ -166,6 +164,18 @@ impl Ggx {
         let nh = t1.scale(p1) + t2.scale(p2) + vh.scale(nz);
         LVec3::new(ax * nh.x, ay * nh.y, nh.z.max(R::splat(R::TINY))).normalize()
     }
+}
+
+/// The (unnormalized) halfway vector c + v_h of the spherical-cap construction [Dupuy &
+/// Benyoub 2023], in the configuration stretched to unit roughness: v_h the unit stretched
+/// view, c the unit direction of height `z` on the cap z ∈ (−v_h·z, 1] and azimuth 2π `u1`.
+/// It holds for views below the horizon too (the microsurface walk's,
+/// models/multiple_scattering/smith_microsurface.rs).
+#[inline(always)]
+pub fn spherical_cap_halfway<R: Real>(vh: LVec3<R>, z: R, u1: R) -> LVec3<R> {
+    let sin_theta = (R::one() - z * z).max(R::zero()).sqrt();
+    let (s, c) = (R::splat(TWO_PI) * u1).sin_cos();
+    LVec3::new(sin_theta * c + vh.x, sin_theta * s + vh.y, z + vh.z)
 }
 
 impl Distribution for Ggx {

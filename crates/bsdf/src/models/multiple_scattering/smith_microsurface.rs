@@ -701,9 +701,7 @@ fn sample_ggx_visible_below(ax: f64, ay: f64, w: Vec3, u: crate::math::Vec2) -> 
         return None;
     }
     let z = -ws.z + (1.0 + ws.z) * u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (std::f64::consts::TAU * u.y).sin_cos();
-    let h = Vec3::new(r * c, r * s, z) + ws;
+    let h: Vec3 = crate::microfacet::ggx::spherical_cap_halfway::<f64>(ws.into(), z, u.y).into();
     let m = Vec3::new(ax * h.x, ay * h.y, h.z.max(0.0)).normalize_or_zero();
     (m != Vec3::ZERO).then_some(m)
 }
