@@ -339,6 +339,18 @@ fn outer_cuts(mu: f64, alpha: f64, reflection_only: bool, fresnel: TableFresnel)
     outer
 }
 
+/// The inner cuts of one line in its integration variable x = `x_of`(θ): the line's start
+/// (x = 0), the kinks `breaks` (polar angles, from [`line_breaks`]) and its end θ = `end`,
+/// sorted and without repeats.
+fn line_cuts(breaks: &[f64], end: f64, x_of: impl Fn(f64) -> f64) -> Vec<f64> {
+    let mut cuts: Vec<f64> = breaks.iter().map(|&t| x_of(t)).collect();
+    cuts.push(0.0);
+    cuts.push(x_of(end));
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-15);
+    cuts
+}
+
 /// ∫ f(h, i) dω_h over the half-vectors h whose mirror direction i = reflect(o, h) is above
 /// the horizon, for o at cos θ_o = `mu` in the xz-plane and f even in h_y (an isotropic
 /// lobe), by adaptive quadrature to the relative tolerance `tolerance` — the reflection
@@ -383,13 +395,7 @@ pub(crate) fn reflection_integral_adaptive(
                 end,
                 Some(&mut breaks),
             );
-            let x = |theta: f64| (theta.tan() / w).atan();
-            let mut cuts: Vec<f64> = breaks.iter().map(|&t| x(t)).collect();
-            cuts.push(0.0);
-            cuts.push(x(end));
-            cuts.sort_by(f64::total_cmp);
-            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-15);
-            cuts
+            line_cuts(&breaks, end, |theta| (theta.tan() / w).atan())
         },
         |_, x| {
             let (cos_phi, sin_phi) = line.get();
@@ -520,12 +526,7 @@ pub fn directional_albedo_adaptive(
                 end,
                 Some(&mut breaks),
             );
-            let mut cuts: Vec<f64> = breaks.iter().map(|&t| map.x(t)).collect();
-            cuts.push(0.0);
-            cuts.push(map.x(end));
-            cuts.sort_by(f64::total_cmp);
-            cuts.dedup_by(|a, b| (*a - *b).abs() <= 1e-15);
-            cuts
+            line_cuts(&breaks, end, |theta| map.x(theta))
         },
         |_, x| {
             let (cos_phi, sin_phi) = line.get();
