@@ -118,7 +118,7 @@ impl NormalizationTable {
     /// C(σ) for σ ∈ (0, π/2).
     pub fn c(&self, sigma: f64) -> f64 {
         let x = sigma / self.step;
-        let i = (x.floor() as usize).min(Self::INTERVALS - 1);
+        let i = crate::math::cell_index(x, Self::INTERVALS);
         let t = x - i as f64;
         let p1 = self.g[i];
         let p2 = self.g[i + 1];

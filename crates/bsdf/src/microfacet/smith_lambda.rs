@@ -190,7 +190,7 @@ impl LambdaTable {
         let y = c / (self.width * s + c).max(1e-300);
         let n = self.g1.len() - 1;
         let x = (y * n as f64).clamp(0.0, n as f64);
-        let i = (x.floor() as usize).min(n - 1);
+        let i = crate::math::cell_index(x, n);
         let t = x - i as f64;
         let p1 = self.g1[i];
         let p2 = self.g1[i + 1];

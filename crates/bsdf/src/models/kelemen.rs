@@ -336,7 +336,7 @@ impl Kelemen {
         let theta = i.z.min(1.0).acos();
         let step = 0.5 * PI / TABLE_INTERVALS as f64;
         let x = (theta / step).clamp(0.0, TABLE_INTERVALS as f64);
-        let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
+        let k = crate::math::cell_index(x, TABLE_INTERVALS);
         let t = x - k as f64;
         let g = self.tables.matte_g[k] * (1.0 - t) + self.tables.matte_g[k + 1] * t;
         let total = self.tables.matte_cdf[TABLE_INTERVALS];
@@ -459,7 +459,7 @@ impl OpaqueBsdf for Kelemen {
 /// a_s(θ) linearly interpolated in `table`.
 fn albedo_in(table: &[Spectrum], theta: f64) -> Spectrum {
     let x = (theta / (0.5 * PI) * TABLE_INTERVALS as f64).clamp(0.0, TABLE_INTERVALS as f64);
-    let k = (x.floor() as usize).min(TABLE_INTERVALS - 1);
+    let k = crate::math::cell_index(x, TABLE_INTERVALS);
     let t = x - k as f64;
     table[k] * (1.0 - t) + table[k + 1] * t
 }

@@ -167,7 +167,7 @@ impl BodyTable {
         let np = (self.n_phi - 1) as f64;
         let (ti, to, ph) = (ti.clamp(0.0, nt), to.clamp(0.0, nt), ph.clamp(0.0, np));
         let cell = |x: f64, n: usize| {
-            let k = (x.floor() as usize).min(n - 2);
+            let k = crate::math::cell_index(x, n - 1);
             (k, x - k as f64)
         };
         let (a, fa) = cell(ti, self.n_theta);

@@ -476,7 +476,7 @@ impl AlbedoTable {
     #[inline]
     fn column_of(mu: f64) -> (usize, f64) {
         let mu = mu.clamp(0.0, 1.0);
-        let k = ((mu.sqrt() * (MU_NODES - 1) as f64) as usize).min(MU_NODES - 2);
+        let k = crate::math::cell_index(mu.sqrt() * (MU_NODES - 1) as f64, MU_NODES - 1);
         let (p, q) = (mu_node(k), mu_node(k + 1));
         (k, ((mu - p) / (q - p)).clamp(0.0, 1.0))
     }
