@@ -10,7 +10,8 @@
 //! weighted by their mass is the blend's own density), one random number fewer.
 //!
 //! [`SquareNodes`] is the piecewise-linear interpolant on nodes μ_k = (k/(N − 1))² that both
-//! the albedo rows (N = 32) and the compensated dielectric's reflection shares (N = 33) use.
+//! the albedo rows and the compensated dielectric's reflection shares use, on the same 32
+//! nodes, so that one search ([`Located`]) serves both lookups of a direction.
 
 use super::albedo_tables::{AlbedoTable, MU_NODES};
 use crate::math::rng::RandomSource;
@@ -23,6 +24,13 @@ pub struct SquareNodes<const N: usize> {
     values: [f64; N],
     /// (values[k + 1] − values[k]) / (μ_{k+1} − μ_k); the last entry repeats the one before.
     slopes: [f64; N],
+}
+
+/// A μ located among the nodes of a [`SquareNodes`]: its interval k and μ − μ_k.
+#[derive(Clone, Copy, Debug)]
+pub struct Located {
+    k: usize,
+    offset: f64,
 }
 
 /// μ of node k of N.
@@ -82,13 +90,29 @@ impl<const N: usize> SquareNodes<N> {
     /// that holds it, found by its bucket (one load and one comparison, no square root).
     #[inline(always)]
     pub fn at(&self, mu: f64) -> f64 {
+        self.at_located(Self::locate(mu))
+    }
+
+    /// Where μ (clamped to [0, 1]) falls among the nodes: what [`at_located`](Self::at_located)
+    /// reads, so that functions on the same nodes share one search.
+    #[inline(always)]
+    pub fn locate(mu: f64) -> Located {
         let mu = mu.clamp(0.0, 1.0);
-        let b = ((mu * BUCKETS as f64) as usize).min(BUCKETS - 1);
+        let b = crate::math::cell_index(mu * BUCKETS as f64, BUCKETS);
         let mut k = Self::FIRST[b] as usize;
         if k < N - 2 && mu >= Self::NODES[k + 1] {
             k += 1;
         }
-        self.values[k] + (mu - Self::NODES[k]) * self.slopes[k]
+        Located {
+            k,
+            offset: mu - Self::NODES[k],
+        }
+    }
+
+    /// The value at a μ found by [`locate`](Self::locate) on nodes of the same count.
+    #[inline(always)]
+    pub fn at_located(&self, at: Located) -> f64 {
+        self.values[at.k] + at.offset * self.slopes[at.k]
     }
 
     /// The node values.
@@ -135,7 +159,21 @@ impl AlbedoRow {
     /// 1 − E(μ), at least 0: the energy single scattering loses.
     #[inline(always)]
     pub fn missing(&self, mu: f64) -> f64 {
-        (1.0 - self.e.at(mu)).max(0.0)
+        self.missing_located(Self::locate(mu))
+    }
+
+    /// Where μ falls among the row's nodes (μ_k = (k/31)²), for
+    /// [`missing_located`](Self::missing_located) and for other functions tabulated on the
+    /// same nodes.
+    #[inline(always)]
+    pub fn locate(mu: f64) -> Located {
+        SquareNodes::<MU_NODES>::locate(mu)
+    }
+
+    /// [`missing`](Self::missing) at a located μ.
+    #[inline(always)]
+    pub fn missing_located(&self, at: Located) -> f64 {
+        (1.0 - self.e.at_located(at)).max(0.0)
     }
 
     /// E_avg.
@@ -149,10 +187,16 @@ impl AlbedoRow {
     /// missing. The table's `lobe_density(μ, α)`.
     #[inline(always)]
     pub fn lobe_density(&self, mu: f64) -> f64 {
+        self.lobe_density_of_missing(self.missing(mu), mu)
+    }
+
+    /// [`lobe_density`](Self::lobe_density) from 1 − E(μ) already read.
+    #[inline(always)]
+    pub fn lobe_density_of_missing(&self, missing: f64, mu: f64) -> f64 {
         if mu <= 0.0 {
             return 0.0;
         }
-        self.missing(mu) * mu * self.density_norm
+        missing * mu * self.density_norm
     }
 
     /// Draws μ with density 2 (1 − E(μ)) μ / (1 − E_avg) on [0, 1]: an interval by its

@@ -35,9 +35,9 @@
 //! and η² ū_in both become their geometric mean √(ū_out η² ū_in) (the reciprocity
 //! constraint, which the walk satisfies in expectation: the scaling only removes its
 //! noise and, with `masking = "smith"`, the difference between the two maskings' 1 − E;
-//! K by bisection). s_A is tabulated on 33 values of μ (μ_k = (k/32)², linear in between;
+//! K by bisection). s_A is tabulated on E's 32 values of μ (μ_k = (k/31)², linear in between;
 //! node 0 walked at μ_1/4) at the 40 rows of the albedo tables' α axis (built on first use:
-//! 2 × 33 × 4096 walks a row, measured 0.10–0.29 s of CPU a row for α ≤ 1.5, 0.45 s at
+//! 2 × 32 × 4096 walks a row, measured 0.10–0.29 s of CPU a row for α ≤ 1.5, 0.45 s at
 //! α = 3, 0.83 s at α ≈ 10, against 0.07 s for the former Markov-chain model — on one
 //! thread; rows are walked in parallel; cached per distribution kind, masking
 //! and η, so that textured roughness rebuilds a material with lookups only) and
@@ -61,13 +61,15 @@
 //! eval·|cos|/pdf; a direction drawn by WMLT07's sampler reuses its value and density.
 //!
 //! **Cost.** E and the shares are read from their blends at the material's α, made once when
-//! it is built ([`AlbedoRow`], [`SquareNodes`]): a lookup is a square root and a
-//! multiply–add, so the model costs WMLT07's plus three or four lookups (issue 16 point 7
+//! it is built ([`AlbedoRow`], [`SquareNodes`]), on the same μ nodes: a direction's μ is
+//! located once (a bucket load and a comparison) and E and s are then one multiply–add
+//! each, so eval and sample cost WMLT07's plus two searches, pdf plus two (issue 16 point 7
 //! asks ≤ 1.3×; measured in docs/performance.md).
 
-use super::albedo_row::{AlbedoRow, SquareNodes};
+use super::albedo_row::{square_node, AlbedoRow, Located, SquareNodes};
 use super::albedo_tables::{
     kind_of_table, row_alpha, row_weight, table_alpha, AlbedoTable, TableFresnel, ALPHA_NODES,
+    MU_NODES,
 };
 use super::multiple_scattering_dielectric::DielectricFacets;
 use super::smith_microsurface::{HeightDistribution, Microsurface};
@@ -83,8 +85,9 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-/// Nodes of the share tables: μ_k = (k/(N − 1))², dense at grazing incidence.
-const SHARE_NODES: usize = 33;
+/// Nodes of the share tables: μ_k = (k/(N − 1))², dense at grazing incidence — the
+/// albedo rows' nodes, so that a direction's E and share are read after one search.
+const SHARE_NODES: usize = MU_NODES;
 /// Walks per node and side that measure the shares.
 const SHARE_WALKS: usize = 4096;
 /// Seed of the share tables' walks (mixed with the row, side and node).
@@ -94,8 +97,7 @@ const AVERAGE_POINTS: usize = 1024;
 
 #[inline]
 fn share_node(k: usize) -> f64 {
-    let x = k as f64 / (SHARE_NODES - 1) as f64;
-    x * x
+    square_node::<SHARE_NODES>(k)
 }
 
 /// Linear interpolation of node values at μ (for the builders; the per-call lookups use
@@ -423,7 +425,7 @@ impl CompensatedDielectric {
         self.side(w).share.at(w.z.abs())
     }
 
-    #[inline]
+    #[inline(always)]
     fn side(&self, w: Vec3) -> &Side {
         if w.z > 0.0 {
             &self.outside
@@ -432,60 +434,80 @@ impl CompensatedDielectric {
         }
     }
 
-    /// 1 − E_side(μ) for a direction on that side.
-    #[inline]
-    fn missing(&self, w: Vec3) -> f64 {
-        self.side(w).row.missing(w.z.abs())
-    }
-
-    /// a(μ) and u(μ) of the side of `w`.
-    #[inline]
-    fn reflected_and_transmitted(&self, w: Vec3) -> (f64, f64) {
-        let m = self.missing(w);
-        let s = self.reflected_share(w);
-        (s * m, (1.0 - s) * m)
-    }
-
-    /// The compensation lobes, f(i, o) with i the light direction [KC17 §5].
-    #[inline]
-    fn compensation(&self, i: Vec3, o: Vec3) -> Spectrum {
-        let (ai, ui) = self.reflected_and_transmitted(i);
-        let (ao, uo) = self.reflected_and_transmitted(o);
-        let b = self.side(o);
-        if i.z * o.z > 0.0 {
-            self.reflect_tint * (ai * ao * b.reflected_norm)
-        } else {
-            self.transmit_tint * (ui * uo * b.transmitted_norm)
+    /// The side of `w`, 1 − E(μ) there and the share s(μ) of it reflected: one search of
+    /// μ among the nodes that E and s share.
+    #[inline(always)]
+    fn at(&self, w: Vec3) -> DirectionValues<'_> {
+        let side = self.side(w);
+        let at: Located = AlbedoRow::locate(w.z.abs());
+        DirectionValues {
+            side,
+            missing: side.row.missing_located(at),
+            share: side.share.at_located(at),
         }
     }
 
-    /// The compensation lobes for the pair (wo, wi) in the transport mode of `ctx`.
-    #[inline]
-    fn compensation_of(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext) -> Spectrum {
+    /// The compensation lobes, f(i, o) with i the light direction [KC17 §5], from the
+    /// values at i and o: reflection a(μ_i) a(μ_o)/(π ā), transmission u(μ_i) u(μ_o)/(π ū_B),
+    /// with a = s (1 − E) and u = (1 − s)(1 − E). Always inlined: called, it returns its
+    /// spectrum through memory, and the caller's reload of the three channels stalled on the
+    /// stores (measured: 10 ns of 77 per eval).
+    #[inline(always)]
+    fn compensation(&self, i: &DirectionValues, o: &DirectionValues, reflected: bool) -> Spectrum {
+        let (mi, si, mo, so) = (i.missing, i.share, o.missing, o.share);
+        if reflected {
+            self.reflect_tint * (si * mi * (so * mo) * o.side.reflected_norm)
+        } else {
+            self.transmit_tint * ((1.0 - si) * mi * ((1.0 - so) * mo) * o.side.transmitted_norm)
+        }
+    }
+
+    /// The compensation lobes for the pair (wo, wi) in the transport mode of `ctx`, from
+    /// their values.
+    #[inline(always)]
+    fn compensation_of(
+        &self,
+        (wo, vo): (Vec3, &DirectionValues),
+        (wi, vi): (Vec3, &DirectionValues),
+        ctx: &BsdfContext,
+    ) -> Spectrum {
+        let reflected = wo.z * wi.z > 0.0;
         match ctx.mode {
-            TransportMode::Radiance => self.compensation(wi, wo),
-            TransportMode::Importance => self.compensation(wo, wi),
+            TransportMode::Radiance => self.compensation(vi, vo, reflected),
+            TransportMode::Importance => self.compensation(vo, vi, reflected),
         }
     }
 
-    /// Probability of drawing from WMLT07's sampler: E of the view's side.
-    #[inline]
-    fn single_share(&self, wo: Vec3) -> f64 {
-        1.0 - self.missing(wo)
-    }
-
-    /// The mixture density of the pair from WMLT07's density `single_pdf` of it.
-    #[inline]
-    fn mixture_pdf(&self, wo: Vec3, wi: Vec3, single_pdf: f64) -> f64 {
-        let ps = self.single_share(wo);
-        let s = self.reflected_share(wo);
-        let lobe = if wi.z * wo.z > 0.0 {
-            s * self.side(wo).row.lobe_density(wi.z.abs())
+    /// The mixture density of the pair from WMLT07's density `single_pdf` of it and the
+    /// view's values: WMLT07's sampler with probability E(μ_o), else the lobe of reflection
+    /// (probability s) or transmission, whose density is (1 − E(μ_i)) μ_i/(π (1 − E_avg)) on
+    /// the side of wi (`missing_i`: 1 − E(μ_i) where the caller has it).
+    #[inline(always)]
+    fn mixture_pdf(
+        &self,
+        (wo, vo): (Vec3, &DirectionValues),
+        wi: Vec3,
+        missing_i: Option<f64>,
+        single_pdf: f64,
+    ) -> f64 {
+        let ps = 1.0 - vo.missing;
+        let (share, side_i) = if wi.z * wo.z > 0.0 {
+            (vo.share, vo.side)
         } else {
-            (1.0 - s) * self.side(wi).row.lobe_density(wi.z.abs())
+            (1.0 - vo.share, self.side(wi))
         };
-        ps * single_pdf + (1.0 - ps) * lobe
+        let mu = wi.z.abs();
+        let missing_i = missing_i.unwrap_or_else(|| side_i.row.missing(mu));
+        ps * single_pdf + (1.0 - ps) * (share * side_i.row.lobe_density_of_missing(missing_i, mu))
     }
+}
+
+/// What the compensation reads at one direction: its side, 1 − E(μ) and the reflected
+/// share s(μ) there.
+struct DirectionValues<'a> {
+    side: &'a Side,
+    missing: f64,
+    share: f64,
 }
 
 impl Bsdf for CompensatedDielectric {
@@ -500,7 +522,9 @@ impl Bsdf for CompensatedDielectric {
         if wo.z == 0.0 || wi.z == 0.0 {
             return Spectrum::ZERO;
         }
-        let v = self.single.eval(wo, wi, ctx, rng) + self.compensation_of(wo, wi, ctx);
+        let (vo, vi) = (self.at(wo), self.at(wi));
+        let v =
+            self.single.eval(wo, wi, ctx, rng) + self.compensation_of((wo, &vo), (wi, &vi), ctx);
         guard(v, || {
             format!(
                 "{} eval(wo = {wo:?}, wi = {wi:?}, {:?})",
@@ -520,12 +544,13 @@ impl Bsdf for CompensatedDielectric {
             return None;
         }
         // The direction, WMLT07's f·|cos θ_i| and density for it, and the lobe drawn.
-        let (wi, f_ss_cos, single_pdf, lobe) = if rng.next_f64() < self.single_share(wo) {
+        let vo = self.at(wo);
+        let (wi, f_ss_cos, single_pdf, lobe) = if rng.next_f64() < 1.0 - vo.missing {
             let s = self.single.sample(wo, ctx, rng)?;
             (s.wi, s.weight * s.pdf, s.pdf, s.lobe)
         } else {
-            let here = self.side(wo);
-            let reflect = rng.next_f64() < self.reflected_share(wo);
+            let here = vo.side;
+            let reflect = rng.next_f64() < vo.share;
             let there = match (reflect, wo.z > 0.0) {
                 (true, _) => here,
                 (false, true) => &self.inside,
@@ -550,11 +575,13 @@ impl Bsdf for CompensatedDielectric {
         if wi.z == 0.0 {
             return None;
         }
-        let pdf = self.mixture_pdf(wo, wi, single_pdf);
+        let vi = self.at(wi);
+        let pdf = self.mixture_pdf((wo, &vo), wi, Some(vi.missing), single_pdf);
         if !(pdf > 0.0) {
             return None;
         }
-        let weight = (f_ss_cos + self.compensation_of(wo, wi, ctx) * wi.z.abs()) * (1.0 / pdf);
+        let comp = self.compensation_of((wo, &vo), (wi, &vi), ctx);
+        let weight = (f_ss_cos + comp * wi.z.abs()) * (1.0 / pdf);
         let transmitted = wi.z * wo.z < 0.0;
         let eta = match (transmitted, wo.z > 0.0) {
             (false, _) => 1.0,
@@ -574,7 +601,7 @@ impl Bsdf for CompensatedDielectric {
         if wo.z == 0.0 || wi.z == 0.0 {
             return 0.0;
         }
-        let p = self.mixture_pdf(wo, wi, self.single.pdf(wo, wi, ctx));
+        let p = self.mixture_pdf((wo, &self.at(wo)), wi, None, self.single.pdf(wo, wi, ctx));
         guard(p, || {
             format!("{} pdf(wo = {wo:?}, wi = {wi:?})", self.describe())
         })
