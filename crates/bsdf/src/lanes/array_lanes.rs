@@ -214,9 +214,14 @@ macro_rules! array_lanes {
                 }
                 Self::from_bits(r)
             }
+            /// x − x = 0 (NaN for ±∞ and NaN): a subtraction and a compare per vector.
+            /// Written with `is_finite` or |x| < ∞, LLVM turns the test (and its
+            /// conjunction with a sign test) into a floating-point class test that it
+            /// expands lane by lane in integer code on AVX2 (measured: 20 scalar
+            /// instructions per camera sample in the sphere's hit record alone).
             #[inline(always)]
             fn is_finite(self) -> $mask {
-                self.cmp(self, |a, _| a.is_finite())
+                (self - self).eq(Self::zero())
             }
 
             $($special)*

@@ -88,5 +88,17 @@ mod tests {
         assert_eq!(F64x8::select(m, a, b).0[3], 2.0);
         assert_eq!(b.sqrt().0[2], 3f64.sqrt());
         assert_eq!(F64x8::splat(0.5).sin_cos().0 .0[7], 0.5f64.sin());
+        // is_finite: false exactly for ±∞ and NaN (f64::MAX and subnormals are finite).
+        let v = F64x8([
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MAX,
+            -f64::MAX,
+            5e-324,
+            -0.0,
+            1.0,
+        ]);
+        assert_eq!(v.is_finite().bits(), 0b1111_1000);
     }
 }
