@@ -126,7 +126,7 @@ fn clamp_derivative(x: f64) -> f64 {
 /// y)` of a rectangle or disk; unused for spheres). The BVH finds the closest of these,
 /// and only that one is turned into a [`SurfaceHit`] (Mitsuba 3's
 /// `PreliminaryIntersection`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PrimHit {
     pub t: f64,
     pub local: Vec2,

@@ -56,7 +56,7 @@ pub use interaction::{PrimHit, SurfaceHit};
 pub use mesh_data::MeshData;
 pub use ray::{Ray, RayDifferential};
 pub use rectangle::Rectangle;
-pub use scene_geometry::{HitDetail, HitLanes, LaneRays, SceneGeometry};
+pub use scene_geometry::{HitDetail, HitLanes, LaneRays, PacketHit, SceneGeometry};
 pub use shape::Shape;
 pub use solid_angle_sampling::ShapeSample;
 pub use sphere::Sphere;

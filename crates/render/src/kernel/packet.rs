@@ -29,7 +29,7 @@
 use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
 use crate::geometry::ray::offset_origin_lanes;
-use crate::geometry::{HitLanes, LaneRays, RayDifferential, Vec3};
+use crate::geometry::{HitLanes, LaneRays, PacketHit, RayDifferential, Vec3};
 use crate::image::ConstantEnvironment;
 use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
 use crate::lights::{Environment, Light};
@@ -134,6 +134,14 @@ struct Paths<S: Real> {
     eta_scale: S,
     /// Segments so far (the camera ray is segment 1).
     segment: U32x8,
+}
+
+/// The ray queries' results of the current segment, kept across segments so that the
+/// queries write only the lanes that hit (see [`SceneGeometry::hit_lanes`]).
+#[derive(Default)]
+struct SegmentHits {
+    hits: [PacketHit; LANES],
+    record: HitLanes,
 }
 
 /// Up to eight camera rays, made together, waiting for lanes.
@@ -256,6 +264,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes>(
         d: LVec3::zero(),
         rd: [None; LANES],
     };
+    let mut segment = SegmentHits::default();
     let mut paths = Paths::<S> {
         live: 0,
         slot: [0; LANES],
@@ -283,7 +292,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes>(
         if paths.live == 0 {
             break;
         }
-        k.step(&mut paths, sums);
+        k.step(&mut paths, &mut segment, sums);
     }
     sums.truncate(jobs.rows_started * job.xs.len());
     jobs.rows_started
@@ -443,11 +452,15 @@ impl Kernel<'_> {
 
     /// Advances every live lane by one path segment.
     #[inline(always)]
-    fn step<S: ShadingLanes>(&self, paths: &mut Paths<S>, sums: &mut [PixelSums]) {
+    fn step<S: ShadingLanes>(
+        &self,
+        paths: &mut Paths<S>,
+        segment: &mut SegmentHits,
+        sums: &mut [PixelSums],
+    ) {
         let scene = self.scene;
         let rays = LaneRays::new(paths.o, paths.d, G::splat(f64::INFINITY), paths.live);
-        let hits = scene.geometry.intersect_lanes(&rays);
-        let hit_set: Lanes = (0..LANES).fold(0, |s, i| s | ((hits[i].is_some() as Lanes) << i));
+        let hit_set = scene.geometry.intersect_lanes(&rays, &mut segment.hits);
         let missed = paths.live & !hit_set;
         if missed != 0 {
             self.environment(paths, missed);
@@ -456,8 +469,11 @@ impl Kernel<'_> {
         if paths.live == 0 {
             return;
         }
-        let hl = scene.geometry.hit_lanes(&rays, &hits);
-        self.area_emission(paths, &hl);
+        scene
+            .geometry
+            .hit_lanes(&rays, &segment.hits, hit_set, &mut segment.record);
+        let hl = &segment.record;
+        self.area_emission(paths, hl);
         let deep = set_of(paths.segment.ge_splat(scene.integrator.max_depth)) & paths.live;
         if deep != 0 {
             Self::finish(paths, deep, sums);
@@ -512,9 +528,9 @@ impl Kernel<'_> {
             .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
             .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
         if self.strategy != Strategy::BsdfOnly {
-            self.next_event(paths, &hl, &frame, wo, &bsdfs, smooth & paths.live, block);
+            self.next_event(paths, hl, &frame, wo, &bsdfs, smooth & paths.live, block);
         }
-        self.continue_paths(paths, &hl, &frame, wo, &bsdfs, block, sums);
+        self.continue_paths(paths, hl, &frame, wo, &bsdfs, block, sums);
     }
 
     /// Emission seen by the rays of `missed` leaving the scene.

@@ -16,7 +16,7 @@ use crate::geometry::{Vec2, Vec3};
 use facette_bsdf::lanes::{F64x8, LVec3, M64x8, Real};
 
 /// A packet lane's closest hit: the primitive's slot in the BVH order and the hit.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct PacketHit {
     slot: u32,
     hit: PrimHit,
@@ -135,6 +135,25 @@ pub struct HitLanes {
     pub lanes: Lanes,
 }
 
+impl Default for HitLanes {
+    /// No lane, every field zero.
+    fn default() -> Self {
+        let zero = LVec3::zero();
+        HitLanes {
+            t: F64x8::zero(),
+            p: zero,
+            ng: zero,
+            ns: zero,
+            dpdu: zero,
+            dpdv: zero,
+            uv: [[0.0; PACKET]; 2],
+            shape: [0; PACKET],
+            prim: [0; PACKET],
+            lanes: 0,
+        }
+    }
+}
+
 impl HitLanes {
     /// Lane `i`'s record.
     #[inline]
@@ -178,10 +197,26 @@ impl HitLanes {
 struct Closest<'a> {
     geometry: &'a SceneGeometry,
     rays: &'a LaneRays,
-    /// The caller's result, written in place (a by-value array here was copied out with
-    /// `memcpy` at every query).
-    best: &'a mut [Option<PacketHit>; PACKET],
-    tri: [Option<TriangleRay>; PACKET],
+    /// The caller's result, written in place for the lanes that hit (a by-value array
+    /// here was copied out with `memcpy` at every query).
+    best: &'a mut [PacketHit; PACKET],
+    /// The lanes with a hit so far.
+    found: Lanes,
+    tri: TriangleRays,
+}
+
+/// Each lane's triangle set-up, made at its first triangle test: none is made, and the
+/// 640 bytes of eight empty slots are not even cleared, for a query that meets no triangle
+/// (the clearing was a `memset` per query on sphere scenes).
+#[derive(Default)]
+struct TriangleRays(Option<[Option<TriangleRay>; PACKET]>);
+
+impl TriangleRays {
+    /// Lane `i`'s slot.
+    #[inline(always)]
+    fn lane(&mut self, i: usize) -> &mut Option<TriangleRay> {
+        &mut self.0.get_or_insert([None; PACKET])[i]
+    }
 }
 
 impl Closest<'_> {
@@ -194,30 +229,32 @@ impl Closest<'_> {
             let (hit, t) = self.rays.sphere(s, lanes, t_max);
             for i in lanes_of(hit) {
                 t_max[i] = t[i];
-                self.best[i] = Some(PacketHit {
+                self.best[i] = PacketHit {
                     slot: slot as u32,
                     hit: PrimHit {
                         t: t[i],
                         local: Vec2::ZERO,
                     },
-                });
+                };
             }
+            self.found |= hit;
             return hit;
         }
         let mut found = 0;
         for i in lanes_of(lanes) {
             let ray = self.rays.ray(i);
-            if let Some(h) = g.test_prim(slot, &ray, &mut self.tri[i], t_max[i]) {
+            if let Some(h) = g.test_prim(slot, &ray, self.tri.lane(i), t_max[i]) {
                 if h.t <= t_max[i] {
                     t_max[i] = h.t;
-                    self.best[i] = Some(PacketHit {
+                    self.best[i] = PacketHit {
                         slot: slot as u32,
                         hit: h,
-                    });
+                    };
                     found |= 1 << i;
                 }
             }
         }
+        self.found |= found;
         found
     }
 }
@@ -226,7 +263,7 @@ impl Closest<'_> {
 struct Occluded<'a> {
     geometry: &'a SceneGeometry,
     rays: &'a LaneRays,
-    tri: [Option<TriangleRay>; PACKET],
+    tri: TriangleRays,
 }
 
 impl Occluded<'_> {
@@ -240,7 +277,7 @@ impl Occluded<'_> {
         lanes_of(lanes).fold(0, |hit, i| {
             let ray = self.rays.ray(i);
             let occluded = g
-                .test_prim(slot, &ray, &mut self.tri[i], t_max[i])
+                .test_prim(slot, &ray, self.tri.lane(i), t_max[i])
                 .is_some();
             hit | ((occluded as Lanes) << i)
         })
@@ -269,34 +306,40 @@ impl SceneGeometry {
     /// the surface record of one.
     #[inline(always)]
     pub fn intersect_packet(&self, rays: &[Option<Ray>; PACKET]) -> [Option<PacketHit>; PACKET] {
-        self.intersect_lanes(&LaneRays::from_rays(rays))
+        let mut hits = [PacketHit::default(); PACKET];
+        let found = self.intersect_lanes(&LaneRays::from_rays(rays), &mut hits);
+        std::array::from_fn(|i| (found & (1 << i) != 0).then_some(hits[i]))
     }
 
-    /// [`intersect_packet`](Self::intersect_packet) for rays already in lanes.
+    /// [`intersect_packet`](Self::intersect_packet) for rays already in lanes: the lanes
+    /// with a hit, whose hits are written to `hits` (the other lanes of `hits` are left as
+    /// they were: the caller keeps one buffer across queries, nothing is copied out).
     #[inline(always)]
-    pub fn intersect_lanes(&self, rays: &LaneRays) -> [Option<PacketHit>; PACKET] {
-        let mut best: [Option<PacketHit>; PACKET] = [None; PACKET];
+    pub fn intersect_lanes(&self, rays: &LaneRays, hits: &mut [PacketHit; PACKET]) -> Lanes {
         let lanes = rays.lanes;
         if lanes == 0 {
-            return best;
+            return 0;
         }
         if !self.packet_traversal() {
+            let mut found = 0;
             for i in lanes_of(lanes) {
-                best[i] = self
-                    .closest_slot(&rays.ray(i))
-                    .map(|(slot, hit)| PacketHit {
+                if let Some((slot, hit)) = self.closest_slot(&rays.ray(i)) {
+                    hits[i] = PacketHit {
                         slot: slot as u32,
                         hit,
-                    });
+                    };
+                    found |= 1 << i;
+                }
             }
-            return best;
+            return found;
         }
         let mut t_max = rays.t_max.0;
         let mut q = Closest {
             geometry: self,
             rays,
-            best: &mut best,
-            tri: [None; PACKET],
+            best: hits,
+            found: 0,
+            tri: TriangleRays::default(),
         };
         match self.bvh.single_leaf() {
             // A scene of a few primitives: no box to test.
@@ -313,7 +356,7 @@ impl SceneGeometry {
                     });
             }
         }
-        best
+        q.found
     }
 
     /// The surface record of `ray`'s hit `hit` found by
@@ -324,27 +367,23 @@ impl SceneGeometry {
         self.hit_record(hit.slot as usize, ray, hit.hit, detail)
     }
 
-    /// The surface records of the hits `hits` of `rays` (found by
-    /// [`intersect_lanes`](Self::intersect_lanes)) in lanes: spheres hit by several lanes
-    /// eight lanes at a time, every other hit lane by lane.
+    /// The surface records of the hits `hits` of `rays` in the lanes `found` (as
+    /// [`intersect_lanes`](Self::intersect_lanes) gives them), written into `out`: spheres
+    /// hit by several lanes eight lanes at a time, every other hit lane by lane. Only the
+    /// lanes of `found` are written (and `out.lanes` set to them): the caller keeps one
+    /// record across segments, neither cleared nor copied out (a `memset` and a `memcpy`
+    /// of its 1.1 KB per segment before).
     #[inline(always)]
-    pub fn hit_lanes(&self, rays: &LaneRays, hits: &[Option<PacketHit>; PACKET]) -> HitLanes {
-        let zero = LVec3::zero();
-        let mut out = HitLanes {
-            t: F64x8::zero(),
-            p: zero,
-            ng: zero,
-            ns: zero,
-            dpdu: zero,
-            dpdv: zero,
-            uv: [[0.0; PACKET]; 2],
-            shape: [0; PACKET],
-            prim: [0; PACKET],
-            lanes: 0,
-        };
-        let mut todo: Lanes = (0..PACKET).fold(0, |s, i| s | ((hits[i].is_some() as Lanes) << i));
-        out.lanes = todo;
-        let shape_of = |i: usize| hits[i].map_or(0, |h| self.prims[h.slot as usize].shape);
+    pub fn hit_lanes(
+        &self,
+        rays: &LaneRays,
+        hits: &[PacketHit; PACKET],
+        found: Lanes,
+        out: &mut HitLanes,
+    ) {
+        out.lanes = found;
+        let mut todo = found;
+        let shape_of = |i: usize| self.prims[hits[i].slot as usize].shape;
         while todo != 0 {
             let first = todo.trailing_zeros() as usize;
             let shape = shape_of(first);
@@ -354,21 +393,27 @@ impl SceneGeometry {
             todo &= !group;
             match &self.shapes[shape as usize] {
                 Shape::Sphere(sphere) if group.count_ones() > 1 => {
-                    let t = F64x8::from_fn(|i| hits[i].map_or(0.0, |h| h.hit.t));
+                    let t = F64x8::from_fn(|i| hits[i].hit.t);
                     let (p, n, dpdu, _) = sphere.shading_hit_lanes(rays.o, rays.d, t);
                     let m = M64x8::from_bits(group as u32);
+                    let zero = LVec3::zero();
                     out.t = F64x8::select(m, t, out.t);
                     out.p = LVec3::select(m, p, out.p);
                     out.ng = LVec3::select(m, n, out.ng);
                     out.ns = LVec3::select(m, n, out.ns);
                     out.dpdu = LVec3::select(m, dpdu, out.dpdu);
+                    // What the one-lane record leaves for `complete_hit`: zero.
+                    out.dpdv = LVec3::select(m, zero, out.dpdv);
                     for i in lanes_of(group) {
                         out.shape[i] = shape;
+                        out.prim[i] = 0;
+                        out.uv[0][i] = 0.0;
+                        out.uv[1][i] = 0.0;
                     }
                 }
                 _ => {
                     for i in lanes_of(group) {
-                        let h = hits[i].expect("a hit lane");
+                        let h = hits[i];
                         let rec = self.hit_record(
                             h.slot as usize,
                             &rays.ray(i),
@@ -380,7 +425,6 @@ impl SceneGeometry {
                 }
             }
         }
-        out
     }
 
     /// [`occluded_ray`](Self::occluded_ray) for every ray of a packet: the occluded lanes
@@ -406,7 +450,7 @@ impl SceneGeometry {
         let mut q = Occluded {
             geometry: self,
             rays,
-            tri: [None; PACKET],
+            tri: TriangleRays::default(),
         };
         let mut test = |slot, lanes| q.test(slot, lanes, &t_max);
         match self.bvh.single_leaf() {
