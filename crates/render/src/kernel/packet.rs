@@ -120,7 +120,7 @@ struct Paths<S: Real> {
     live: Lanes,
     /// Each lane's pixel, as an index into the tile's sums.
     slot: [u32; LANES],
-    streams: [SampleStream; LANES],
+    streams: LaneStreams,
     samples: SampleLanes,
     o: LVec3<G>,
     d: LVec3<G>,
@@ -149,11 +149,79 @@ struct CameraBatch {
     count: usize,
     next: usize,
     slot: [u32; LANES],
-    streams: [SampleStream; LANES],
+    streams: LaneStreams,
     samples: SampleLanes,
     o: LVec3<G>,
     d: LVec3<G>,
     rd: [Option<RayDifferential>; LANES],
+}
+
+/// Each lane's [`SampleStream`], made at its first use from the lane's camera sample: a lane
+/// whose sample has a lane form ([`SampleLanes`]) draws its numbers in lanes and needs its
+/// stream only when a model asks for further numbers (stochastic models, the f64 models
+/// lane by lane), so most camera samples never make one (making and moving it cost about
+/// 200 instructions a camera sample). A stream made late is the stream made early: it is a
+/// pure function of (seed, pixel, sample number), and nothing draws from it before.
+struct LaneStreams {
+    streams: [SampleStream; LANES],
+    /// Each lane's camera sample: pixel x, y and sample number.
+    of: [(usize, usize, u64); LANES],
+    /// The lanes whose stream is made.
+    made: Lanes,
+}
+
+impl LaneStreams {
+    fn new(sampler: &PixelSampler) -> Self {
+        LaneStreams {
+            streams: std::array::from_fn(|_| sampler.stream(0, 0, 0)),
+            of: [(0, 0, 0); LANES],
+            made: 0,
+        }
+    }
+
+    /// Lane `i` holds camera sample `sample` of pixel (x, y); its stream is not made.
+    #[inline(always)]
+    fn assign(&mut self, i: usize, of: (usize, usize, u64)) {
+        self.of[i] = of;
+        self.made &= !(1 << i);
+    }
+
+    /// Lane `i` of `self` takes lane `j` of `from` (its stream too, where made).
+    #[inline(always)]
+    fn take(&mut self, i: usize, from: &mut LaneStreams, j: usize) {
+        self.of[i] = from.of[j];
+        if from.made & (1 << j) != 0 {
+            std::mem::swap(&mut self.streams[i], &mut from.streams[j]);
+            from.made &= !(1 << j);
+            self.made |= 1 << i;
+        } else {
+            self.made &= !(1 << i);
+        }
+    }
+
+    /// Makes the streams of `set` that are not made yet.
+    #[inline(always)]
+    fn make(&mut self, set: Lanes, sampler: &PixelSampler) {
+        for i in lanes_of(set & !self.made) {
+            let (x, y, s) = self.of[i];
+            self.streams[i] = sampler.stream(x, y, s);
+        }
+        self.made |= set;
+    }
+
+    /// Lane `i`'s stream, made if it was not.
+    #[inline(always)]
+    fn lane(&mut self, i: usize, sampler: &PixelSampler) -> &mut SampleStream {
+        self.make(1 << i, sampler);
+        &mut self.streams[i]
+    }
+
+    /// Every stream, for the sampler's lanes without a lane form (made when assigned:
+    /// see [`Kernel::make_batch`]).
+    #[inline(always)]
+    fn all(&mut self) -> &mut [SampleStream; LANES] {
+        &mut self.streams
+    }
 }
 
 /// The (pixel, sample) jobs of a tile, row by row; `stop` is asked before each row.
@@ -253,12 +321,11 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes>(
         stop: job.stop,
         ended: false,
     };
-    let placeholder = || job.sampler.stream(0, 0, 0);
     let mut batch = CameraBatch {
         count: 0,
         next: 0,
         slot: [0; LANES],
-        streams: std::array::from_fn(|_| placeholder()),
+        streams: LaneStreams::new(job.sampler),
         samples: SampleLanes::default(),
         o: LVec3::zero(),
         d: LVec3::zero(),
@@ -268,7 +335,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes>(
     let mut paths = Paths::<S> {
         live: 0,
         slot: [0; LANES],
-        streams: std::array::from_fn(|_| placeholder()),
+        streams: LaneStreams::new(job.sampler),
         samples: SampleLanes::default(),
         o: LVec3::zero(),
         d: LVec3::zero(),
@@ -328,8 +395,8 @@ impl Kernel<'_> {
             let j = batch.next;
             batch.next += 1;
             paths.slot[i] = batch.slot[j];
-            std::mem::swap(&mut paths.streams[i], &mut batch.streams[j]);
-            paths.samples.set(i, self.sampler, &paths.streams[i]);
+            paths.streams.take(i, &mut batch.streams, j);
+            paths.samples.copy_lane(i, &batch.samples, j);
             for (p, b) in [(&mut paths.o, &batch.o), (&mut paths.d, &batch.d)] {
                 p.x.0[i] = b.x.0[j];
                 p.y.0[i] = b.y.0[j];
@@ -366,8 +433,10 @@ impl Kernel<'_> {
         let mut py = [0.0; LANES];
         let mut n = 0;
         for (x, y, s, slot) in jobs.by_ref().take(LANES) {
-            batch.streams[n] = self.sampler.stream(x, y, s as u64);
-            batch.samples.set(n, self.sampler, &batch.streams[n]);
+            batch.streams.assign(n, (x, y, s as u64));
+            batch
+                .samples
+                .set_words(n, self.sampler.lane_words_at(x, y, s as u64));
             batch.slot[n] = slot;
             px[n] = x as f64 + 0.5;
             py[n] = y as f64 + 0.5;
@@ -379,11 +448,15 @@ impl Kernel<'_> {
             return false;
         }
         let active: Lanes = ((1u32 << n) - 1) as Lanes;
+        // Samples without a lane form read every number from their streams: made now.
+        batch
+            .streams
+            .make(active & !batch.samples.fast(), self.sampler);
         let scene = self.scene;
         // The filter offset (dimensions 0, 1), then the lens position (2, 3) where read.
         let (u0, u1) = self.sampler.get_lanes::<S>(
             &batch.samples,
-            &mut batch.streams,
+            batch.streams.all(),
             U32x8::splat(0),
             active,
             true,
@@ -394,7 +467,7 @@ impl Kernel<'_> {
         let lens = if scene.camera.has_lens() {
             let (l0, l1) = self.sampler.get_lanes::<S>(
                 &batch.samples,
-                &mut batch.streams,
+                batch.streams.all(),
                 U32x8::splat(2),
                 active,
                 true,
@@ -629,7 +702,7 @@ impl Kernel<'_> {
         let u_select = if selector.reads_selection_number() {
             to_g(
                 self.sampler
-                    .get_lanes::<S>(&paths.samples, &mut paths.streams, block, set, false)
+                    .get_lanes::<S>(&paths.samples, paths.streams.all(), block, set, false)
                     .0,
             )
         } else {
@@ -638,7 +711,7 @@ impl Kernel<'_> {
         let (u0, u1) = if selector.reads_position_numbers() {
             self.sampler.get_lanes::<S>(
                 &paths.samples,
-                &mut paths.streams,
+                paths.streams.all(),
                 block.wrapping_add(U32x8::splat(1)),
                 set,
                 true,
@@ -808,6 +881,7 @@ impl Kernel<'_> {
                     todo &= !group;
                     let mut free = FreeNumbers {
                         streams: &mut paths.streams,
+                        sampler: self.sampler,
                         group,
                     };
                     let (v, p) = S::eval_pdf(model, wo, wi, &mut free);
@@ -820,7 +894,8 @@ impl Kernel<'_> {
                     todo &= !(1 << first);
                     let ctx = BsdfContext::RADIANCE;
                     let (o, i) = (wo.lane(first), wi.lane(first));
-                    let v = bsdf.eval(o, i, &ctx, paths.streams[first].rng()) * i.z.abs();
+                    let rng = paths.streams.lane(first, self.sampler).rng();
+                    let v = bsdf.eval(o, i, &ctx, rng) * i.z.abs();
                     if !v.is_black() {
                         rgb_set(f, first, v);
                         let p = bsdf.pdf(o, i, &ctx);
@@ -866,7 +941,7 @@ impl Kernel<'_> {
                 self.sampler
                     .get_lanes::<S>(
                         &paths.samples,
-                        &mut paths.streams,
+                        paths.streams.all(),
                         block.wrapping_add(U32x8::splat(3)),
                         lobe_set,
                         false,
@@ -877,7 +952,7 @@ impl Kernel<'_> {
             };
             let (u0, u1) = self.sampler.get_lanes::<S>(
                 &paths.samples,
-                &mut paths.streams,
+                paths.streams.all(),
                 block.wrapping_add(U32x8::splat(4)),
                 lane_set,
                 true,
@@ -895,6 +970,7 @@ impl Kernel<'_> {
                 todo &= !group;
                 let mut free = FreeNumbers {
                     streams: &mut paths.streams,
+                    sampler: self.sampler,
                     group,
                 };
                 let s = S::sample(model, wo, u_lobe, u0, u1, &mut free);
@@ -915,7 +991,8 @@ impl Kernel<'_> {
             let VertexBsdf::Scalar(bsdf) = &bsdfs[i] else {
                 continue;
             };
-            let mut source = PrefixedSource::new(&mut paths.streams[i], block.lane(i) + 3);
+            let stream = paths.streams.lane(i, self.sampler);
+            let mut source = PrefixedSource::new(stream, block.lane(i) + 3);
             let Some(s) = bsdf.sample(wo.lane(i), &ctx, &mut source) else {
                 continue;
             };
@@ -964,7 +1041,7 @@ impl Kernel<'_> {
                 .sampler
                 .get_lanes::<S>(
                     &paths.samples,
-                    &mut paths.streams,
+                    paths.streams.all(),
                     block.wrapping_add(U32x8::splat(6)),
                     rr,
                     false,
@@ -990,7 +1067,8 @@ impl Kernel<'_> {
 /// A lane model's further random numbers: each lane's free PCG stream, as the scalar
 /// integrator's stochastic models draw them, for the lanes of the model's group that ask.
 struct FreeNumbers<'a> {
-    streams: &'a mut [SampleStream; LANES],
+    streams: &'a mut LaneStreams,
+    sampler: &'a PixelSampler,
     group: Lanes,
 }
 
@@ -1000,7 +1078,7 @@ impl<S: Real> LaneRandom<S> for FreeNumbers<'_> {
         let mut u = [[0.0; 2]; LANES];
         for i in lanes_of(self.group) {
             if lanes.lane(i) {
-                let d = self.streams[i].rng().next_2d();
+                let d = self.streams.lane(i, self.sampler).rng().next_2d();
                 u[i] = [d.x, d.y];
             }
         }

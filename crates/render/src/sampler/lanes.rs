@@ -28,9 +28,29 @@ pub(crate) struct SampleLanes {
 
 impl SampleLanes {
     /// Lane `i` takes the state of `stream`.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn set(&mut self, i: usize, sampler: &PixelSampler, stream: &SampleStream) {
-        match sampler.lane_words(stream) {
+        self.set_words(i, sampler.lane_words(stream));
+    }
+
+    /// The lanes with a lane form.
+    #[inline(always)]
+    pub(crate) fn fast(&self) -> u8 {
+        self.fast
+    }
+
+    /// Lane `i` takes lane `j` of `from`.
+    #[inline(always)]
+    pub(crate) fn copy_lane(&mut self, i: usize, from: &SampleLanes, j: usize) {
+        self.words[0][i] = from.words[0][j];
+        self.words[1][i] = from.words[1][j];
+        self.fast = (self.fast & !(1 << i)) | (((from.fast >> j) & 1) << i);
+    }
+
+    /// Lane `i` takes the lane form `words` ([`PixelSampler::lane_words_at`]), or none.
+    #[inline]
+    pub(crate) fn set_words(&mut self, i: usize, words: Option<[u32; 2]>) {
+        match words {
             Some(w) => {
                 self.words[0][i] = w[0];
                 self.words[1][i] = w[1];
@@ -42,8 +62,23 @@ impl SampleLanes {
 }
 
 impl PixelSampler {
-    /// The lane form of a stream's sample, where it has one.
+    /// The lane form of camera sample `sample_index` of pixel (x, y), where it has one:
+    /// `lane_words(&self.stream(x, y, sample_index))` without making the stream (whose
+    /// generator seeding, pattern state and copies cost the render kernel about 200
+    /// instructions a camera sample when no model drew from it).
     #[inline]
+    pub(crate) fn lane_words_at(&self, x: usize, y: usize, sample_index: u64) -> Option<[u32; 2]> {
+        match &self.layout {
+            super::Layout::Sobol(z) => z.lane_word_at(x, y, sample_index).map(|w| [w, 0]),
+            super::Layout::Independent => Some(super::split(
+                self.independent_key(self.pixel(x, y), sample_index),
+            )),
+            super::Layout::Stratified(_) => None,
+        }
+    }
+
+    /// The lane form of a stream's sample, where it has one.
+    #[cfg(test)]
     fn lane_words(&self, stream: &SampleStream) -> Option<[u32; 2]> {
         match &stream.pattern {
             super::Pattern::Sobol(z) => z.lane_word().map(|w| [w, 0]),
@@ -151,6 +186,17 @@ mod tests {
                 let mut lanes = SampleLanes::default();
                 for (i, st) in streams.iter().enumerate() {
                     lanes.set(i, &sampler, st);
+                    // The words made without the stream are the stream's, also for sample
+                    // numbers beyond the spp (another key).
+                    let x = (round as usize * 7 + i * 13) % w;
+                    let y = (round as usize + i) % h;
+                    for s in [(round + i as u32) % spp as u32, spp as u32 + round] {
+                        assert_eq!(
+                            sampler.lane_words_at(x, y, s as u64),
+                            sampler.lane_words(&sampler.stream(x, y, s as u64)),
+                            "{kind:?} {w} ({x}, {y}) sample {s}"
+                        );
+                    }
                 }
                 let expect_fast = if kind == SamplerKind::Stratified || wide {
                     0

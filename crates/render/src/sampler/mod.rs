@@ -148,17 +148,28 @@ impl PixelSampler {
         self.kind
     }
 
+    /// The renderer's seeding since before samplers existed: (y · width + x) as u64
+    /// (wrapping only where that product overflowed usize anyway).
+    #[inline(always)]
+    fn pixel(&self, x: usize, y: usize) -> u64 {
+        (y as u64).wrapping_mul(self.width).wrapping_add(x as u64)
+    }
+
+    /// An independent sample's key.
+    #[inline(always)]
+    fn independent_key(&self, pixel: u64, sample_index: u64) -> u64 {
+        mix_seed(mix_seed(self.seed ^ INDEPENDENT_TAG, pixel), sample_index)
+    }
+
     /// The stream of one camera sample: a pure function of (seed, pixel, sample_index).
     #[inline]
     pub fn stream(&self, x: usize, y: usize, sample_index: u64) -> SampleStream {
-        // The renderer's seeding since before samplers existed: (y · width + x) as u64
-        // (wrapping only where that product overflowed usize anyway).
-        let pixel = (y as u64).wrapping_mul(self.width).wrapping_add(x as u64);
+        let pixel = self.pixel(x, y);
         let rng = Pcg32::new(mix_seed(self.seed, pixel), sample_index);
         let pattern = match &self.layout {
             Layout::Sobol(z) => Pattern::Sobol(z.start(x, y, sample_index)),
             Layout::Independent => Pattern::Independent {
-                key: mix_seed(mix_seed(self.seed ^ INDEPENDENT_TAG, pixel), sample_index),
+                key: self.independent_key(pixel, sample_index),
             },
             Layout::Stratified(s) => Pattern::Stratified(s.start(x, y, sample_index)),
         };

@@ -289,9 +289,10 @@ impl ZSobol {
         2 * self.levels + self.log2_spp
     }
 
-    /// The state of one camera sample.
-    #[inline]
-    pub(crate) fn start(&self, x: usize, y: usize, sample_index: u64) -> ZSobolSample {
+    /// The index of a camera sample (its pixel's Morton code in the tile, then the sample
+    /// number) and what did not fit in it: the tile and the sample number's high part.
+    #[inline(always)]
+    fn index_of(&self, x: usize, y: usize, sample_index: u64) -> (u64, [u64; 3]) {
         let (x, y) = (x as u64, y as u64);
         // levels ≤ 32, so the in-tile coordinates fit in u32 and the shifts in u64.
         let in_tile = (1u64 << self.levels) - 1;
@@ -306,28 +307,58 @@ impl ZSobol {
             (sample_index & mask, sample_index >> self.log2_spp)
         };
         let index = morton.checked_shl(self.log2_spp).unwrap_or(0) | low;
+        (index, [tile_x, tile_y, extra])
+    }
+
+    /// An index of at most 32 bits reversed at the top of the word (0 for wider ones).
+    #[inline(always)]
+    fn reversed(&self, index: u64) -> u32 {
+        let bits = self.index_bits();
+        if bits == 0 || bits > 32 {
+            0
+        } else {
+            ((index as u32) << (32 - bits)).reverse_bits()
+        }
+    }
+
+    /// The state of one camera sample.
+    #[inline]
+    pub(crate) fn start(&self, x: usize, y: usize, sample_index: u64) -> ZSobolSample {
+        let (index, rest) = self.index_of(x, y, sample_index);
         // 0, 0, 0 for every pixel of an image that fits: then `key` is one constant per
         // seed and this is exactly the ZSobol design.
-        let key = if (tile_x, tile_y, extra) == (0, 0, 0) {
+        let key = if rest == [0, 0, 0] {
             // The same three hashes, made once per render.
             self.common_key
         } else {
+            let [tile_x, tile_y, extra] = rest;
             mix_seed(
                 mix_seed(mix_seed(self.seed ^ ZSOBOL_TAG, tile_x), tile_y),
                 extra,
             )
         };
-        let bits = self.index_bits();
         ZSobolSample {
             layout: *self,
             index,
             key,
-            reversed: if bits == 0 || bits > 32 {
-                0
-            } else {
-                ((index as u32) << (32 - bits)).reverse_bits()
-            },
+            reversed: self.reversed(index),
         }
+    }
+
+    /// [`start`](Self::start)`(x, y, sample_index).lane_word()` without making the sample:
+    /// the render kernel's lanes need only this word unless a model draws further numbers.
+    #[inline]
+    pub(crate) fn lane_word_at(&self, x: usize, y: usize, sample_index: u64) -> Option<u32> {
+        if self.index_bits() > 32 {
+            return None;
+        }
+        let (index, rest) = self.index_of(x, y, sample_index);
+        if rest != [0, 0, 0] {
+            // Another tile or a sample number beyond the spp: the key decides (a hash that
+            // equals the common key by chance gives the lane form, as in `lane_word`).
+            return self.start(x, y, sample_index).lane_word();
+        }
+        Some(self.reversed(index))
     }
 
     /// The key of every sample when the index has at most 32 bits (one tile) and the sample
