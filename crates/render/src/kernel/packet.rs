@@ -373,6 +373,30 @@ struct Kernel<'a> {
     strategy: Strategy,
 }
 
+/// The materials of a vertex: each lane's, the lanes whose material is a lane model and
+/// those among them whose model reads a lobe number, and whether those lanes share one
+/// model (then a model's group is found without comparing lanes) — found once, where the
+/// materials are looked up.
+struct VertexMaterials<'s> {
+    bsdfs: [VertexBsdf<'s>; LANES],
+    lane_models: Lanes,
+    reads_lobe: Lanes,
+    one_lane_model: bool,
+}
+
+impl VertexMaterials<'_> {
+    /// The lanes of `todo` whose lane model is `model`.
+    #[inline(always)]
+    fn group_of(&self, model: &LaneBsdf, todo: Lanes) -> Lanes {
+        if self.one_lane_model {
+            return todo & self.lane_models;
+        }
+        lanes_of(todo)
+            .filter(|&i| matches!(&self.bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, model)))
+            .fold(0, |s, i| s | (1 << i))
+    }
+}
+
 /// One lane's material at a vertex.
 enum VertexBsdf<'s> {
     None,
@@ -555,14 +579,31 @@ impl Kernel<'_> {
             return;
         }
         // The materials.
-        let mut bsdfs: [VertexBsdf; LANES] = std::array::from_fn(|_| VertexBsdf::None);
+        let mut vertex = VertexMaterials {
+            bsdfs: std::array::from_fn(|_| VertexBsdf::None),
+            lane_models: 0,
+            reads_lobe: 0,
+            one_lane_model: true,
+        };
+        let mut first_model: Option<&LaneBsdf> = None;
         let mut smooth: Lanes = 0;
         let mut no_bsdf: Lanes = 0;
         for i in lanes_of(paths.live) {
             let material = scene.shape_material[hl.shape[i] as usize] as usize;
             let m = &scene.materials[material];
+            let bsdfs = &mut vertex.bsdfs;
             bsdfs[i] = match m.lane_bsdf() {
-                Some(lane) => VertexBsdf::Lane(lane),
+                Some(lane) => {
+                    vertex.lane_models |= 1 << i;
+                    if lane.reads_lobe_number() {
+                        vertex.reads_lobe |= 1 << i;
+                    }
+                    match first_model {
+                        None => first_model = Some(lane),
+                        Some(f) => vertex.one_lane_model &= std::ptr::eq(f, lane),
+                    }
+                    VertexBsdf::Lane(lane)
+                }
                 None => {
                     let mut hit = hl.surface_hit(i);
                     let mut derivs = [0.0; 4];
@@ -581,7 +622,7 @@ impl Kernel<'_> {
                     }
                 }
             };
-            let flags = match &bsdfs[i] {
+            let flags = match &vertex.bsdfs[i] {
                 VertexBsdf::Lane(l) => l.flags(),
                 VertexBsdf::Scalar(b) => b.flags(),
                 VertexBsdf::None => LobeFlags::NONE,
@@ -601,9 +642,9 @@ impl Kernel<'_> {
             .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
             .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
         if self.strategy != Strategy::BsdfOnly {
-            self.next_event(paths, hl, &frame, wo, &bsdfs, smooth & paths.live, block);
+            self.next_event(paths, hl, &frame, wo, &vertex, smooth & paths.live, block);
         }
-        self.continue_paths(paths, hl, &frame, wo, &bsdfs, block, sums);
+        self.continue_paths(paths, hl, &frame, wo, &vertex, block, sums);
     }
 
     /// Emission seen by the rays of `missed` leaving the scene.
@@ -690,7 +731,7 @@ impl Kernel<'_> {
         hl: &HitLanes,
         frame: &LFrame<G>,
         wo: LVec3<S>,
-        bsdfs: &[VertexBsdf; LANES],
+        vertex: &VertexMaterials,
         set: Lanes,
         block: U32x8,
     ) {
@@ -723,12 +764,19 @@ impl Kernel<'_> {
         let mut light_of = [usize::MAX; LANES];
         let mut p_select = [0.0; LANES];
         let mut chosen: Lanes = 0;
-        for i in lanes_of(set) {
-            if let Some((k, p)) = selector.select(u_select.0[i]) {
-                light_of[i] = k;
-                p_select[i] = p;
-                chosen |= 1 << i;
+        if selector.reads_selection_number() {
+            for i in lanes_of(set) {
+                if let Some((k, p)) = selector.select(u_select.0[i]) {
+                    light_of[i] = k;
+                    p_select[i] = p;
+                    chosen |= 1 << i;
+                }
             }
+        } else if let Some((k, p)) = selector.select(0.5) {
+            // One light can be chosen: every lane's, whatever its number (½ above).
+            light_of = [k; LANES];
+            p_select = [p; LANES];
+            chosen = set;
         }
         // Light samples: direction (world), radiance, density, the shadow ray's origin and
         // length, delta lights.
@@ -831,7 +879,7 @@ impl Kernel<'_> {
         // The materials' values (f·|cos θ_i|) and densities.
         let mut f: Rgb<S> = [S::zero(); 3];
         let mut pdf = S::zero();
-        self.eval_materials(paths, bsdfs, wo, wi_local, candidates, &mut f, &mut pdf);
+        self.eval_materials(paths, vertex, wo, wi_local, candidates, &mut f, &mut pdf);
         let black = set_of(f[0].eq(S::zero()) & f[1].eq(S::zero()) & f[2].eq(S::zero()));
         candidates &= !black;
         if candidates == 0 {
@@ -862,7 +910,7 @@ impl Kernel<'_> {
     fn eval_materials<S: ShadingLanes>(
         &self,
         paths: &mut Paths<S>,
-        bsdfs: &[VertexBsdf; LANES],
+        vertex: &VertexMaterials,
         wo: LVec3<S>,
         wi: LVec3<S>,
         set: Lanes,
@@ -873,11 +921,9 @@ impl Kernel<'_> {
         let mut todo = set;
         while todo != 0 {
             let first = todo.trailing_zeros() as usize;
-            match &bsdfs[first] {
+            match &vertex.bsdfs[first] {
                 VertexBsdf::Lane(model) => {
-                    let group = lanes_of(todo)
-                        .filter(|&i| matches!(&bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, *model)))
-                        .fold(0, |s, i| s | (1 << i));
+                    let group = vertex.group_of(model, todo);
                     todo &= !group;
                     let mut free = FreeNumbers {
                         streams: &mut paths.streams,
@@ -917,7 +963,7 @@ impl Kernel<'_> {
         hl: &HitLanes,
         frame: &LFrame<G>,
         wo: LVec3<S>,
-        bsdfs: &[VertexBsdf; LANES],
+        vertex: &VertexMaterials,
         block: U32x8,
         sums: &mut [PixelSums],
     ) {
@@ -930,13 +976,9 @@ impl Kernel<'_> {
         let mut transmitted: Lanes = 0;
         let mut ok: Lanes = 0;
         // Lane models: the lobe number where a model reads it, the direction pair.
-        let lane_set = lanes_of(live)
-            .filter(|&i| matches!(bsdfs[i], VertexBsdf::Lane(_)))
-            .fold(0, |s, i| s | (1 << i));
+        let lane_set = vertex.lane_models & live;
         if lane_set != 0 {
-            let lobe_set = lanes_of(lane_set)
-                .filter(|&i| matches!(bsdfs[i], VertexBsdf::Lane(m) if m.reads_lobe_number()))
-                .fold(0, |s, i| s | (1 << i));
+            let lobe_set = vertex.reads_lobe & live;
             let u_lobe = if lobe_set != 0 {
                 self.sampler
                     .get_lanes::<S>(
@@ -959,14 +1001,10 @@ impl Kernel<'_> {
             );
             let mut todo = lane_set;
             while todo != 0 {
-                let VertexBsdf::Lane(model) = &bsdfs[todo.trailing_zeros() as usize] else {
+                let VertexBsdf::Lane(model) = &vertex.bsdfs[todo.trailing_zeros() as usize] else {
                     unreachable!("a lane-model lane");
                 };
-                let group = lanes_of(todo)
-                    .filter(
-                        |&i| matches!(&bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, *model)),
-                    )
-                    .fold(0, |s, i| s | (1 << i));
+                let group = vertex.group_of(model, todo);
                 todo &= !group;
                 let mut free = FreeNumbers {
                     streams: &mut paths.streams,
@@ -988,7 +1026,7 @@ impl Kernel<'_> {
         // The f64 models, lane by lane, from their vertex's dimensions then the free stream.
         let ctx = BsdfContext::RADIANCE;
         for i in lanes_of(live & !lane_set) {
-            let VertexBsdf::Scalar(bsdf) = &bsdfs[i] else {
+            let VertexBsdf::Scalar(bsdf) = &vertex.bsdfs[i] else {
                 continue;
             };
             let stream = paths.streams.lane(i, self.sampler);
