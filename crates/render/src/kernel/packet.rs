@@ -242,7 +242,7 @@ impl Iterator for Jobs<'_> {
     /// (x, y, sample index, slot).
     type Item = (usize, usize, u32, u32);
 
-    #[inline]
+    #[inline(always)]
     fn next(&mut self) -> Option<Self::Item> {
         if self.ended || self.chunk.is_empty() || self.xs.is_empty() {
             return None;

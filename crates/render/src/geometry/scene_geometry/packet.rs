@@ -382,14 +382,21 @@ impl SceneGeometry {
         out: &mut HitLanes,
     ) {
         out.lanes = found;
+        if found == 0 {
+            return;
+        }
+        // Every lane's shape (the lanes without a hit read a stale or default slot, which
+        // is a valid one: the scene has primitives since a lane hit one), then the lanes
+        // of each shape by one comparison per lane.
+        let shapes: [u32; PACKET] =
+            std::array::from_fn(|i| self.prims[hits[i].slot as usize].shape);
         let mut todo = found;
-        let shape_of = |i: usize| self.prims[hits[i].slot as usize].shape;
         while todo != 0 {
             let first = todo.trailing_zeros() as usize;
-            let shape = shape_of(first);
-            let group = lanes_of(todo)
-                .filter(|&i| shape_of(i) == shape)
-                .fold(0, |s, i| s | (1 << i));
+            let shape = shapes[first];
+            let group = (0..PACKET)
+                .fold(0, |m: Lanes, i| m | (((shapes[i] == shape) as Lanes) << i))
+                & todo;
             todo &= !group;
             match &self.shapes[shape as usize] {
                 Shape::Sphere(sphere) if group.count_ones() > 1 => {
