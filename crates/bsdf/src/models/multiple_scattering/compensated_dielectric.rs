@@ -95,22 +95,6 @@ const SHARE_SEED: u64 = 0x5eed_5a4e;
 /// Midpoints of the rule that averages the lobes over μ.
 const AVERAGE_POINTS: usize = 1024;
 
-#[inline]
-fn share_node(k: usize) -> f64 {
-    square_node::<SHARE_NODES>(k)
-}
-
-/// Linear interpolation of node values at μ (for the builders; the per-call lookups use
-/// the material's [`SquareNodes`]).
-#[inline]
-fn interpolate(values: &[f64; SHARE_NODES], mu: f64) -> f64 {
-    let x = mu.clamp(0.0, 1.0).sqrt() * (SHARE_NODES - 1) as f64;
-    let k = (x as usize).min(SHARE_NODES - 2);
-    let (p, q) = (share_node(k), share_node(k + 1));
-    let t = ((mu - p) / (q - p)).clamp(0.0, 1.0);
-    values[k] + t * (values[k + 1] - values[k])
-}
-
 /// The shares s_out, s_in of the missing energy that leave on the light's own side, at the
 /// nodes (see the module header).
 #[derive(Clone, Debug)]
@@ -203,6 +187,7 @@ impl ShareRows {
             let (alpha_a, alpha_b) = (row_alpha(j), row_alpha(j + 1));
             let moments =
                 |table: &AlbedoTable, sa: &[f64; SHARE_NODES], sb: &[f64; SHARE_NODES]| {
+                    let (sa, sb) = (SquareNodes::new(*sa), SquareNodes::new(*sb));
                     let mut q = [0.0; 3];
                     let h = 1.0 / AVERAGE_POINTS as f64;
                     for k in 0..AVERAGE_POINTS {
@@ -212,7 +197,7 @@ impl ShareRows {
                             (1.0 - table.albedo(mu, alpha_a)).max(0.0),
                             (1.0 - table.albedo(mu, alpha_b)).max(0.0),
                         );
-                        let (ua, ub) = (1.0 - interpolate(sa, mu), 1.0 - interpolate(sb, mu));
+                        let (ua, ub) = (1.0 - sa.at(mu), 1.0 - sb.at(mu));
                         q[0] += w * ua * ma;
                         q[1] += w * (ua * mb + ub * ma);
                         q[2] += w * ub * mb;
@@ -264,7 +249,7 @@ fn walk_shares(ndf: &Ndf, row: usize, eta: f64) -> Shares {
         .map(|state| {
             let (side, k) = (state / SHARE_NODES, state % SHARE_NODES);
             // Node 0 (μ = 0) is walked at a quarter of node 1's cosine.
-            let mu = share_node(k).max(0.25 * share_node(1));
+            let mu = square_node::<SHARE_NODES>(k).max(0.25 * square_node::<SHARE_NODES>(1));
             let z = if side == 0 { mu } else { -mu };
             let wi = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, z);
             let seed = mix_seed(SHARE_SEED, (row * 2 * SHARE_NODES + state) as u64);
@@ -292,14 +277,16 @@ fn walk_shares(ndf: &Ndf, row: usize, eta: f64) -> Shares {
     out
 }
 
-/// (ā, ū): 2 ∫ s (1 − E) μ dμ and 2 ∫ (1 − s)(1 − E) μ dμ on the interpolants.
+/// (ā, ū): 2 ∫ s (1 − E) μ dμ and 2 ∫ (1 − s)(1 − E) μ dμ on the interpolants (the
+/// shares' the material reads, [`SquareNodes`]).
 fn averages(table: &AlbedoTable, alpha: f64, share: &[f64; SHARE_NODES]) -> (f64, f64) {
+    let share = SquareNodes::new(*share);
     let (mut a, mut u) = (0.0, 0.0);
     let h = 1.0 / AVERAGE_POINTS as f64;
     for k in 0..AVERAGE_POINTS {
         let mu = (k as f64 + 0.5) * h;
         let missing = (1.0 - table.albedo(mu, alpha)).max(0.0);
-        let s = interpolate(share, mu);
+        let s = share.at(mu);
         a += 2.0 * mu * h * s * missing;
         u += 2.0 * mu * h * (1.0 - s) * missing;
     }
