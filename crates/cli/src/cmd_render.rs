@@ -163,6 +163,9 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
             return Ok(ExitCode::from(130));
         }
         let (partial, stats) = res.map_err(anyhow::Error::msg)?;
+        for w in scene.shading_warnings() {
+            eprintln!("warning: {w}");
+        }
         start_writing();
         partial.save(&output)?;
         if !a.quiet {
@@ -179,6 +182,9 @@ pub fn run(a: RenderArgs) -> Result<ExitCode> {
     }
     let (film, stats) = render(&scene, &opts, &cancel, &progress).map_err(anyhow::Error::msg)?;
     pb.finish_and_clear();
+    for w in scene.shading_warnings() {
+        eprintln!("warning: {w}");
+    }
 
     let exposure = a.exposure.unwrap_or(scene.film.exposure);
     let image = film.image();

@@ -1,7 +1,10 @@
 //! Scene materials: a validated [`MaterialRecipe`] and the textures that drive some of its
-//! parameters. Untextured materials are built once and shared; textured ones are rebuilt
-//! per shading point from the recipe with the textured values substituted (cheap: the
-//! recipes share their precomputed tables).
+//! parameters. Untextured materials are built once and shared. A textured material with a
+//! lane model gives the packet kernel its texture values per shading point
+//! ([`SceneMaterial::lane_texel`]: colors, or the lane model with a textured roughness; no
+//! allocation). Otherwise (and in the scalar kernel) it is rebuilt per shading point from
+//! the recipe with the textured values substituted (the recipes share their precomputed
+//! tables).
 //!
 //! In a material table any texturable parameter may be a texture instead of a number:
 //!
@@ -15,11 +18,12 @@
 //! default (`encoding` overrides). A roughness texture's value is its channel average.
 
 use crate::image::{read_image, ColorEncoding, ImageNormalMapReader, MipMap, Texture, WrapMode};
-use facette_bsdf::models::LaneBsdf;
+use facette_bsdf::models::{LaneBsdf, LaneColorParam, LaneColors};
 use facette_bsdf::recipe::MaterialRecipe;
 use facette_bsdf::{Bsdf, Spectrum};
 use glam::DVec2;
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// One textured parameter.
@@ -28,6 +32,28 @@ struct TexturedParam {
     key: &'static str,
     spectrum: bool,
     texture: Texture,
+    /// The range of values the texture takes, validated at load time (a roughness texture's
+    /// value is held to it).
+    range: (f64, f64),
+    /// What the texture drives in the material's lane model, where it has one.
+    lane: Option<LaneTarget>,
+}
+
+/// A texture's parameter in a lane model.
+#[derive(Clone, Copy, Debug)]
+enum LaneTarget {
+    Color(LaneColorParam),
+    /// The roughness key of the parameter.
+    Roughness,
+}
+
+/// A textured lane material at one shading point.
+#[derive(Clone, Debug)]
+pub enum LaneTexel {
+    /// Textured colors only: the material's lane model with these spectral parameters.
+    Colors(LaneColors<f64>),
+    /// A textured roughness: the lane model built for this point (colors included).
+    Model(LaneBsdf),
 }
 
 /// A material of the scene.
@@ -36,9 +62,14 @@ pub struct SceneMaterial {
     pub name: String,
     recipe: MaterialRecipe,
     fixed: Option<Arc<dyn Bsdf>>,
-    /// The lane model of an untextured material that vectorizes (the packet kernel's).
+    /// The lane model of a material that vectorizes (the packet kernel's); a textured
+    /// material's holds its untextured parameters, [`lane_texel`](Self::lane_texel) the
+    /// textured ones.
     lane: Option<LaneBsdf>,
     textures: Vec<TexturedParam>,
+    /// Shading points whose material could not be built from their texture values (their
+    /// paths end there); shared by the material's clones, reported after a render.
+    failures: Arc<AtomicU64>,
 }
 
 impl std::fmt::Debug for SceneMaterial {
@@ -99,6 +130,8 @@ impl SceneMaterial {
                     key: k,
                     spectrum: true,
                     texture,
+                    range: (lo, hi),
+                    lane: None,
                 });
             } else if let Some(k) = scalar_keys.iter().find(|k| **k == key) {
                 recipe
@@ -111,6 +144,8 @@ impl SceneMaterial {
                     key: k,
                     spectrum: false,
                     texture,
+                    range: (lo, hi),
+                    lane: None,
                 });
             } else {
                 let mut valid: Vec<&str> = spectrum_keys.to_vec();
@@ -129,13 +164,33 @@ impl SceneMaterial {
         // anyway so that a material that cannot be built fails at load time.
         let built = recipe.build().map_err(|e| e.to_string())?;
         let fixed = (textures.is_empty() && !recipe.varies_per_hit()).then_some(built);
-        let lane = fixed.as_ref().and_then(|_| recipe.lane_model());
+        let mut lane = (!recipe.varies_per_hit())
+            .then(|| recipe.lane_model())
+            .flatten();
+        if let Some(model) = &lane {
+            // Every texture must map onto the lane model, its extremes valid there too;
+            // otherwise the material renders through its f64 model.
+            for t in &mut textures {
+                t.lane = if t.spectrum {
+                    model.color_param(t.key).map(LaneTarget::Color)
+                } else {
+                    let (lo, hi) = t.range;
+                    (model.with_roughness(t.key, lo).is_ok()
+                        && model.with_roughness(t.key, hi).is_ok())
+                    .then_some(LaneTarget::Roughness)
+                };
+            }
+            if textures.iter().any(|t| t.lane.is_none()) {
+                lane = None;
+            }
+        }
         Ok(SceneMaterial {
             name: name.to_string(),
             recipe,
             fixed,
             lane,
             textures,
+            failures: Arc::default(),
         })
     }
 
@@ -150,6 +205,7 @@ impl SceneMaterial {
             fixed,
             lane,
             textures: Vec::new(),
+            failures: Arc::default(),
         })
     }
 
@@ -159,10 +215,62 @@ impl SceneMaterial {
         self.recipe.render_cost_warning()
     }
 
-    /// The material's lane model, where it has one (see `facette_bsdf::lanes`).
+    /// The material's lane model, where it has one (see `facette_bsdf::lanes`); a textured
+    /// material's takes its textured values from [`lane_texel`](Self::lane_texel).
     #[inline]
     pub fn lane_bsdf(&self) -> Option<&LaneBsdf> {
         self.lane.as_ref()
+    }
+
+    /// A textured lane material's parameters at a shading point with texture coordinates
+    /// `uv` and footprint `derivs` (as [`bsdf`](Self::bsdf) reads them): its textured
+    /// colors, or its lane model built with a textured roughness. `None` for a material
+    /// without a lane model, or where a texture's value is not a valid parameter (which the
+    /// load-time checks of the textures' ranges rule out; such a point would be counted,
+    /// see [`failed_shading_points`](Self::failed_shading_points)).
+    pub fn lane_texel(&self, uv: DVec2, derivs: [f64; 4]) -> Option<LaneTexel> {
+        let model = self.lane.as_ref()?;
+        let mut colors = model.colors();
+        let mut rough: Option<LaneBsdf> = None;
+        for t in &self.textures {
+            match t.lane? {
+                LaneTarget::Color(param) => {
+                    let v = t.texture.eval(uv, derivs).map(|x| x.clamp(0.0, 1.0));
+                    if !v.0.iter().all(|x| x.is_finite()) {
+                        return self.failed();
+                    }
+                    param.set(&mut colors, v);
+                }
+                LaneTarget::Roughness => {
+                    // Held to the range validated at load time (filtering stays inside it
+                    // but for rounding).
+                    let (lo, hi) = t.range;
+                    let v = t.texture.eval_scalar(uv, derivs);
+                    let base = rough.as_ref().unwrap_or(model);
+                    match base.with_roughness(t.key, v.clamp(lo, hi)) {
+                        Ok(m) if v.is_finite() => rough = Some(m),
+                        _ => return self.failed(),
+                    }
+                }
+            }
+        }
+        Some(match rough {
+            Some(m) => LaneTexel::Model(m.with_colors(&colors)),
+            None => LaneTexel::Colors(colors),
+        })
+    }
+
+    /// Counts a shading point whose material could not be built.
+    #[cold]
+    fn failed<T>(&self) -> Option<T> {
+        self.failures.fetch_add(1, Ordering::Relaxed);
+        None
+    }
+
+    /// How many shading points so far could not be built from their texture values (their
+    /// paths ended there); the renderer reports them after a render.
+    pub fn failed_shading_points(&self) -> u64 {
+        self.failures.load(Ordering::Relaxed)
     }
 
     pub fn is_textured(&self) -> bool {
@@ -187,11 +295,10 @@ impl SceneMaterial {
             return Some(MaterialBsdf::Shared(f.as_ref()));
         }
         if self.textures.is_empty() {
-            return self
-                .recipe
-                .build_at(uv, derivs)
-                .ok()
-                .map(MaterialBsdf::Textured);
+            return match self.recipe.build_at(uv, derivs) {
+                Ok(b) => Some(MaterialBsdf::Textured(b)),
+                Err(_) => self.failed(),
+            };
         }
         let mut r = self.recipe.clone();
         for t in &self.textures {
@@ -203,10 +310,13 @@ impl SceneMaterial {
                     .is_ok()
             };
             if !ok {
-                return None;
+                return self.failed();
             }
         }
-        r.build_at(uv, derivs).ok().map(MaterialBsdf::Textured)
+        match r.build_at(uv, derivs) {
+            Ok(b) => Some(MaterialBsdf::Textured(b)),
+            Err(_) => self.failed(),
+        }
     }
 }
 

@@ -9,6 +9,11 @@ use facette_render::scene::load_scene_str;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Mutex;
+
+/// Held by each test for its whole run: the counter is global, so the tests of this file
+/// must not allocate while another measures.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 /// The system allocator, counting the allocations made.
 struct Counting;
@@ -92,9 +97,32 @@ type = "constant"
 radiance = 0.2
 "#;
 
+/// The lane materials of [`SCENE`] with textured parameters: colors (the glass's
+/// transmittance, the plane's reflectance) and a roughness (the conductor's).
+fn textured_scene() -> String {
+    SCENE
+        .replace(
+            "ior = 1.5 }",
+            "ior = 1.5, specular_transmittance = { texture = \"checker\", a = 0.7, b = 1.0, scale = 6 } }",
+        )
+        .replace(
+            "alpha = 0.2, material",
+            "alpha = { texture = \"checker\", a = 0.1, b = 0.4, scale = 8 }, material",
+        )
+        .replace(
+            "reflectance = 0.7 }",
+            "reflectance = { texture = \"checker\", a = [0.2, 0.5, 0.7], b = 0.8, scale = 10 } }",
+        )
+}
+
 /// Allocations made by one single-threaded render of `spp` samples per pixel.
 fn allocations(spp: usize, kernel: Kernel) -> u64 {
-    let scene = load_scene_str(SCENE, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"));
+    allocations_of(SCENE, spp, kernel)
+}
+
+/// [`allocations`] of the scene `source`.
+fn allocations_of(source: &str, spp: usize, kernel: Kernel) -> u64 {
+    let scene = load_scene_str(source, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"));
     let opts = RenderOptions {
         spp: Some(spp),
         threads: Some(1),
@@ -110,6 +138,7 @@ fn allocations(spp: usize, kernel: Kernel) -> u64 {
 
 #[test]
 fn a_render_allocates_nothing_per_sample() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     // 17 and 20 passes of one 32 × 32 tile: the few per-pass allocations cancel out to a
     // handful, and the rest of the difference is what the 32 × 32 × 224 extra samples
     // allocate (one per sample or per vertex would be ≥ 229,376).
@@ -126,4 +155,35 @@ fn a_render_allocates_nothing_per_sample() {
             "{kernel:?}: {per_sample} heap allocations per extra camera sample ({few} → {many})"
         );
     }
+}
+
+/// Textured lane materials read their textures into lane parameters in the packet kernel:
+/// no recipe rebuilt and no model allocated per hit either. (The scalar kernel still
+/// rebuilds a textured material per hit, see `SceneMaterial::bsdf`.)
+#[test]
+fn a_packet_render_of_textured_lane_materials_allocates_nothing_per_sample() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let source = textured_scene();
+    let scene = load_scene_str(&source, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let textured = scene
+        .materials
+        .iter()
+        .filter(|m| m.is_textured() && m.lane_bsdf().is_some())
+        .count();
+    assert_eq!(textured, 3, "the textured lane materials");
+    let few = allocations_of(&source, 32, Kernel::Packet);
+    let many = allocations_of(&source, 256, Kernel::Packet);
+    let per_sample = many.saturating_sub(few) as f64 / (32 * 32 * (256 - 32)) as f64;
+    println!("textured, packet: allocations {few} at 32 spp, {many} at 256 spp");
+    assert!(
+        per_sample < 1e-3,
+        "{per_sample} heap allocations per extra camera sample ({few} → {many})"
+    );
+    // The scalar kernel's rebuild per hit is what the count would catch.
+    let scalar_few = allocations_of(&source, 4, Kernel::Scalar);
+    let scalar_many = allocations_of(&source, 8, Kernel::Scalar);
+    assert!(
+        scalar_many - scalar_few > 32 * 32 * 4,
+        "the scalar kernel's textured hits allocate ({scalar_few} → {scalar_many})"
+    );
 }

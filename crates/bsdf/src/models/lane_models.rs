@@ -20,6 +20,7 @@
 //! The tests compare every value, density and sample with the f64 models at the same random
 //! numbers: 1e-9 relative in the f64 instantiation, 1e-3 in f32 lanes.
 
+use super::lane_colors::{ColorSource, OwnColors};
 use crate::bsdf::LobeFlags;
 use crate::fresnel::conductor::fresnel_conductor_lanes;
 use crate::fresnel::dielectric::fresnel_dielectric_lanes;
@@ -27,6 +28,8 @@ use crate::fresnel::Fresnel;
 use crate::lanes::{LVec3, Mask, Real};
 use crate::math::INV_PI;
 use crate::microfacet::{Beckmann, Ggx, Ndf};
+use crate::recipe::microfacet::with_roughness;
+use crate::{ParamError, ParamResult};
 
 /// A distribution the lane models support.
 #[derive(Clone, Debug)]
@@ -184,6 +187,10 @@ pub enum LaneBsdf {
         body: [f64; 3],
         /// The probability of sampling the specular lobe [IL18 §4.1].
         specular_probability: f64,
+        /// The interface's external and internal diffuse reflectances r_e and r_i (what a
+        /// textured K_d needs, `LaneColorParam::Kd`).
+        re: f64,
+        ri: f64,
     },
 }
 
@@ -214,8 +221,8 @@ fn mirror<R: Real>(w: LVec3<R>, s: R) -> LVec3<R> {
 }
 
 #[inline(always)]
-fn tinted<R: Real>(tint: &[f64; 3], v: R) -> [R; 3] {
-    std::array::from_fn(|c| R::splat(tint[c]) * v)
+fn tinted<R: Real>(tint: &[R; 3], v: R) -> [R; 3] {
+    std::array::from_fn(|c| tint[c] * v)
 }
 
 /// Malley's cosine-weighted hemisphere from Shirley–Chiu's concentric disk (the f64
@@ -243,12 +250,39 @@ impl LaneBsdf {
     /// The lane form of a rough, single-scattering, stochastic interfaced Lambertian model
     /// whose lobe has the lane distribution `ndf`.
     pub fn il(ndf: LaneNdf, il: &crate::models::il::InterfacedLambertian) -> LaneBsdf {
+        let (re, ri) = il.diffuse_reflectances();
         LaneBsdf::Il {
             ndf,
             ni: il.ni(),
             body: il.body_factor().0.map(|k| k * INV_PI),
             specular_probability: il.specular_probability(),
+            re,
+            ri,
         }
+    }
+
+    /// The model with the roughness parameter `key` (`alpha`, `alpha_u`, `alpha_v`) set to
+    /// `v`, validated as the material table's value is (what a roughness texture drives).
+    pub fn with_roughness(&self, key: &str, v: f64) -> ParamResult<LaneBsdf> {
+        let mut m = self.clone();
+        let ndf = match &mut m {
+            LaneBsdf::Lambert { .. } => {
+                return Err(ParamError::Invalid(format!(
+                    "`{key}`: Lambert has no roughness"
+                )))
+            }
+            LaneBsdf::Conductor { ndf, .. }
+            | LaneBsdf::Dielectric { ndf, .. }
+            | LaneBsdf::Il { ndf, .. } => ndf,
+        };
+        let general = match ndf {
+            LaneNdf::Ggx(g) => Ndf::Ggx(*g),
+            LaneNdf::Beckmann(b) => Ndf::Beckmann(*b),
+        };
+        *ndf = LaneNdf::from_ndf(&with_roughness(&general, key, v)?).ok_or_else(|| {
+            ParamError::Invalid(format!("`{key}` changed the distribution's family"))
+        })?;
+        Ok(m)
     }
 
     /// Whether [`sample`](Self::sample) reads its lobe number `u_lobe` (the dielectric's
@@ -273,13 +307,28 @@ impl LaneBsdf {
         wi: LVec3<R>,
         rng: &mut impl LaneRandom<R>,
     ) -> ([R; 3], R) {
+        self.eval_pdf_with(&OwnColors, wo, wi, rng)
+    }
+
+    /// [`eval_pdf`](Self::eval_pdf) with the spectral parameters of `colors` (a texture's,
+    /// per lane).
+    #[inline(always)]
+    pub fn eval_pdf_with<R: Real>(
+        &self,
+        colors: &impl ColorSource<R>,
+        wo: LVec3<R>,
+        wi: LVec3<R>,
+        rng: &mut impl LaneRandom<R>,
+    ) -> ([R; 3], R) {
         match self {
             LaneBsdf::Lambert { reflectance } => {
                 let same = (wo.z * wi.z).gt(R::zero());
                 let pdf = R::masked(same, wi.z.abs() * R::splat(INV_PI));
-                (tinted(reflectance, R::masked(same, R::splat(INV_PI))), pdf)
+                let reflectance = colors.tint(reflectance);
+                (tinted(&reflectance, R::masked(same, R::splat(INV_PI))), pdf)
             }
             LaneBsdf::Conductor { ndf, fresnel, tint } => {
+                let tint = colors.tint(tint);
                 let s = upper(wo);
                 let (o, i) = (mirror(wo, s), mirror(wi, s));
                 let h = (o + i).normalize();
@@ -290,7 +339,7 @@ impl LaneBsdf {
                 let pdf = ndf.pdf_visible(o, h, d) / (R::splat(4.0) * cos_oh);
                 let f = fresnel.eval(cos_oh);
                 let ok = ok & geom.gt(R::zero());
-                let v = std::array::from_fn(|c| R::masked(ok, R::splat(tint[c]) * f[c] * geom));
+                let v = std::array::from_fn(|c| R::masked(ok, tint[c] * f[c] * geom));
                 (v, R::masked(ok & pdf.is_finite(), pdf))
             }
             LaneBsdf::Dielectric {
@@ -298,20 +347,30 @@ impl LaneBsdf {
                 eta,
                 reflect_tint,
                 transmit_tint,
-            } => Self::dielectric_eval_pdf(ndf, *eta, reflect_tint, transmit_tint, wo, wi),
+            } => Self::dielectric_eval_pdf(
+                ndf,
+                *eta,
+                &colors.tint(reflect_tint),
+                &colors.transmit_tint(transmit_tint),
+                wo,
+                wi,
+            ),
             LaneBsdf::Il {
                 ndf,
                 ni,
                 body,
                 specular_probability,
+                ..
             } => {
                 let s = upper(wo);
                 let (o, i) = (mirror(wo, s), mirror(wi, s));
                 let same = (wo.z * wi.z).gt(R::zero());
-                let (spec, pdf) = Self::il_specular(ndf, *ni, *specular_probability, o, i);
+                let ps = colors.specular_probability(*specular_probability);
+                let (spec, pdf) = Self::il_specular(ndf, *ni, ps, o, i);
                 let (u0, u1) = rng.next_2d(same);
                 let b = Self::il_body(ndf, *ni, o, i, u0, u1);
-                let f = std::array::from_fn(|c| R::masked(same, spec + R::splat(body[c]) * b));
+                let body = colors.tint(body);
+                let f = std::array::from_fn(|c| R::masked(same, spec + body[c] * b));
                 (f, R::masked(same, pdf))
             }
         }
@@ -321,8 +380,8 @@ impl LaneBsdf {
     fn dielectric_eval_pdf<R: Real>(
         ndf: &LaneNdf,
         eta: f64,
-        reflect_tint: &[f64; 3],
-        transmit_tint: &[f64; 3],
+        reflect_tint: &[R; 3],
+        transmit_tint: &[R; 3],
         wo: LVec3<R>,
         wi: LVec3<R>,
     ) -> ([R; 3], R) {
@@ -361,7 +420,7 @@ impl LaneBsdf {
         let pdf = R::select(refl, pr, pt);
         let ok = ok & value.is_finite() & pdf.is_finite();
         let v = std::array::from_fn(|c| {
-            let tint = R::select(refl, R::splat(reflect_tint[c]), R::splat(transmit_tint[c]));
+            let tint = R::select(refl, reflect_tint[c], transmit_tint[c]);
             R::masked(ok, tint * value)
         });
         (v, R::masked(ok, pdf))
@@ -374,7 +433,7 @@ impl LaneBsdf {
     fn il_specular<R: Real>(
         ndf: &LaneNdf,
         ni: f64,
-        specular_probability: f64,
+        specular_probability: R,
         o: LVec3<R>,
         i: LVec3<R>,
     ) -> (R, R) {
@@ -389,7 +448,7 @@ impl LaneBsdf {
         let spec = R::select(lobe & spec.gt(zero), spec, zero);
         let spec_pdf = ndf.pdf_visible(o, h, d) / (R::splat(4.0) * cos_oh);
         let spec_pdf = R::select(lobe & spec_pdf.is_finite(), spec_pdf, zero);
-        let ps = R::splat(specular_probability);
+        let ps = specular_probability;
         let pdf = ps * spec_pdf + (R::one() - ps) * R::masked(above, i.z * R::splat(INV_PI));
         (spec, pdf)
     }
@@ -422,21 +481,38 @@ impl LaneBsdf {
         u1: R,
         rng: &mut impl LaneRandom<R>,
     ) -> LaneSample<R> {
+        self.sample_with(&OwnColors, wo, u_lobe, u0, u1, rng)
+    }
+
+    /// [`sample`](Self::sample) with the spectral parameters of `colors` (a texture's, per
+    /// lane).
+    #[inline(always)]
+    pub fn sample_with<R: Real>(
+        &self,
+        colors: &impl ColorSource<R>,
+        wo: LVec3<R>,
+        u_lobe: R,
+        u0: R,
+        u1: R,
+        rng: &mut impl LaneRandom<R>,
+    ) -> LaneSample<R> {
         match self {
             LaneBsdf::Lambert { reflectance } => {
+                let reflectance = colors.tint(reflectance);
                 let s = upper(wo);
                 let wi = cosine_hemisphere(u0, u1);
                 let ok = !wo.z.eq(R::zero()) & wi.z.gt(R::zero());
                 LaneSample {
                     pdf: wi.z * R::splat(INV_PI),
                     wi: mirror(wi, s),
-                    weight: tinted(reflectance, R::one()),
+                    weight: reflectance,
                     eta: R::one(),
                     transmitted: R::Mask::splat(false),
                     ok,
                 }
             }
             LaneBsdf::Conductor { ndf, fresnel, tint } => {
+                let tint = colors.tint(tint);
                 let s = upper(wo);
                 let o = mirror(wo, s);
                 let m = ndf.sample_visible(o, u0, u1);
@@ -454,7 +530,7 @@ impl LaneBsdf {
                     & w.is_finite();
                 LaneSample {
                     wi: mirror(i, s),
-                    weight: std::array::from_fn(|k| R::splat(tint[k]) * f[k] * w),
+                    weight: std::array::from_fn(|k| tint[k] * f[k] * w),
                     pdf,
                     eta: R::one(),
                     transmitted: R::Mask::splat(false),
@@ -466,20 +542,30 @@ impl LaneBsdf {
                 eta,
                 reflect_tint,
                 transmit_tint,
-            } => {
-                Self::dielectric_sample(ndf, *eta, reflect_tint, transmit_tint, wo, u_lobe, u0, u1)
-            }
+            } => Self::dielectric_sample(
+                ndf,
+                *eta,
+                &colors.tint(reflect_tint),
+                &colors.transmit_tint(transmit_tint),
+                wo,
+                u_lobe,
+                u0,
+                u1,
+            ),
             LaneBsdf::Il {
                 ndf,
                 ni,
                 body,
                 specular_probability,
+                ..
             } => {
+                let ps = colors.specular_probability(*specular_probability);
+                let body = colors.tint(body);
                 // The specular lobe's visible-normal reflection or the cosine lobe, then the
                 // value and density of the pair (the f64 model's order of draws).
                 let s = upper(wo);
                 let o = mirror(wo, s);
-                let specular = u_lobe.lt(R::splat(*specular_probability));
+                let specular = u_lobe.lt(ps);
                 let m = ndf.sample_visible(o, u0, u1);
                 let c = o.dot(m);
                 let reflected = m.scale(R::splat(2.0) * c) - o;
@@ -487,12 +573,12 @@ impl LaneBsdf {
                 let lobe_pdf = ndf.pdf_visible(o, m, ndf.d(m)) / (R::splat(4.0) * c);
                 let lobe_ok = c.gt(R::zero()) & lobe_pdf.gt(R::zero()) & lobe_pdf.is_finite();
                 let drawn = !wo.z.eq(R::zero()) & i.z.gt(R::zero()) & (!specular | lobe_ok);
-                let (spec, pdf) = Self::il_specular(ndf, *ni, *specular_probability, o, i);
+                let (spec, pdf) = Self::il_specular(ndf, *ni, ps, o, i);
                 let valued = drawn & pdf.gt(R::zero());
                 let (b0, b1) = rng.next_2d(valued);
                 let b = Self::il_body(ndf, *ni, o, i, b0, b1);
                 let k = i.z / pdf;
-                let weight: [R; 3] = std::array::from_fn(|ch| (spec + R::splat(body[ch]) * b) * k);
+                let weight: [R; 3] = std::array::from_fn(|ch| (spec + body[ch] * b) * k);
                 let ok =
                     valued & weight[0].is_finite() & weight[1].is_finite() & weight[2].is_finite();
                 LaneSample {
@@ -513,11 +599,12 @@ impl LaneBsdf {
     #[inline(never)]
     pub fn eval_pdf_out_of_line<R: Real>(
         &self,
+        colors: &impl ColorSource<R>,
         wo: LVec3<R>,
         wi: LVec3<R>,
         rng: &mut impl LaneRandom<R>,
     ) -> ([R; 3], R) {
-        self.eval_pdf(wo, wi, rng)
+        self.eval_pdf_with(colors, wo, wi, rng)
     }
 
     /// [`sample`](Self::sample) as a function of its own, like
@@ -525,13 +612,14 @@ impl LaneBsdf {
     #[inline(never)]
     pub fn sample_out_of_line<R: Real>(
         &self,
+        colors: &impl ColorSource<R>,
         wo: LVec3<R>,
         u_lobe: R,
         u0: R,
         u1: R,
         rng: &mut impl LaneRandom<R>,
     ) -> LaneSample<R> {
-        self.sample(wo, u_lobe, u0, u1, rng)
+        self.sample_with(colors, wo, u_lobe, u0, u1, rng)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -539,8 +627,8 @@ impl LaneBsdf {
     fn dielectric_sample<R: Real>(
         ndf: &LaneNdf,
         eta: f64,
-        reflect_tint: &[f64; 3],
-        transmit_tint: &[f64; 3],
+        reflect_tint: &[R; 3],
+        transmit_tint: &[R; 3],
         wo: LVec3<R>,
         u_lobe: R,
         u0: R,
@@ -581,8 +669,8 @@ impl LaneBsdf {
         let weight = std::array::from_fn(|ch| {
             R::select(
                 choose_r,
-                R::splat(reflect_tint[ch]) * base,
-                R::splat(transmit_tint[ch]) * base * radiance_scale,
+                reflect_tint[ch] * base,
+                transmit_tint[ch] * base * radiance_scale,
             )
         });
         LaneSample {
@@ -725,8 +813,12 @@ mod tests {
                 let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
                 // The stochastic IL body: both sides draw from equal streams.
                 let free = Pcg32::new(k, 11);
-                let (v, p) =
-                    lane.eval_pdf_out_of_line(wo.into(), wi.into(), &mut FreeLanes(free.clone()));
+                let (v, p) = lane.eval_pdf_out_of_line(
+                    &OwnColors,
+                    wo.into(),
+                    wi.into(),
+                    &mut FreeLanes(free.clone()),
+                );
                 let want = model.eval(wo, wi, &ctx, &mut free.clone());
                 let want_pdf = model.pdf(wo, wi, &ctx);
                 for c in 0..3 {
@@ -756,6 +848,7 @@ mod tests {
                 let (ul, ud) = (rng.next_f64(), rng.next_2d());
                 let free = Pcg32::new(k, 12);
                 let s = lane.sample_out_of_line(
+                    &OwnColors,
                     wo.into(),
                     ul,
                     ud.x,
@@ -821,6 +914,30 @@ mod tests {
 
     /// A model that says it does not read its lobe number samples the same direction and
     /// weight whatever that number is (the renderer then leaves its dimension undrawn).
+    /// A roughness set on a lane model gives the model its recipe builds with that value,
+    /// and a bad value is the recipe's error.
+    #[test]
+    fn a_roughness_equals_the_model_built_with_it() {
+        for table in materials() {
+            let recipe = MaterialRecipe::parse(&table, std::path::Path::new(".")).unwrap();
+            let lane = recipe.lane_model().unwrap();
+            for key in recipe.texturable_scalar_keys() {
+                let set = lane.with_roughness(key, 0.42).unwrap();
+                let mut recipe = recipe.clone();
+                recipe.set_scalar(key, 0.42).unwrap();
+                let expected = recipe.lane_model().unwrap();
+                assert_eq!(format!("{set:?}"), format!("{expected:?}"), "{table} {key}");
+                assert!(lane.with_roughness(key, -1.0).is_err());
+                assert!(lane.with_roughness(key, f64::NAN).is_err());
+            }
+        }
+        let lambert = MaterialRecipe::parse(&materials()[0], std::path::Path::new("."))
+            .unwrap()
+            .lane_model()
+            .unwrap();
+        assert!(lambert.with_roughness("alpha", 0.3).is_err());
+    }
+
     #[test]
     fn one_lobe_models_ignore_the_lobe_number() {
         let mut rng = Pcg32::new(10, 2);
@@ -832,8 +949,9 @@ mod tests {
             for _ in 0..500 {
                 let wo = LVec3::<f64>::from_fn(|_| random_dir(&mut rng));
                 let (u0, u1) = (rng.next_f64(), rng.next_f64());
-                let a = lane.sample_out_of_line(wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
-                let b = lane.sample_out_of_line(wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
+                let a = lane.sample_out_of_line(&OwnColors, wo, 0.0, u0, u1, &mut Given(0.3, 0.6));
+                let b =
+                    lane.sample_out_of_line(&OwnColors, wo, 0.999, u0, u1, &mut Given(0.3, 0.6));
                 assert_eq!(a.ok, b.ok);
                 if a.ok {
                     assert_eq!(a.wi.lane(0), b.wi.lane(0));
@@ -859,8 +977,9 @@ mod tests {
                 let wo8 = LVec3::<F32x8>::from_fn(|i| wo[i]);
                 let wi8 = LVec3::<F32x8>::from_fn(|i| wi[i]);
                 let free8 = || Given(F32x8::from_fn(|i| u[i][3]), F32x8::from_fn(|i| u[i][4]));
-                let (v8, p8) = lane.eval_pdf_out_of_line(wo8, wi8, &mut free8());
+                let (v8, p8) = lane.eval_pdf_out_of_line(&OwnColors, wo8, wi8, &mut free8());
                 let s8 = lane.sample_out_of_line(
+                    &OwnColors,
                     wo8,
                     F32x8::from_fn(|i| u[i][0]),
                     F32x8::from_fn(|i| u[i][1]),
@@ -872,12 +991,18 @@ mod tests {
                     let f32_in = |x: f64| x as f32 as f64;
                     let free = || Given(f32_in(u[i][3]), f32_in(u[i][4]));
                     let (wo_i, wi_i) = (wo8.lane(i), wi8.lane(i));
-                    let (v, p) = lane.eval_pdf_out_of_line(wo_i.into(), wi_i.into(), &mut free());
+                    let (v, p) = lane.eval_pdf_out_of_line(
+                        &OwnColors,
+                        wo_i.into(),
+                        wi_i.into(),
+                        &mut free(),
+                    );
                     // f32 arithmetic moves an ill-conditioned value by more than its rounding
                     // (grazing pairs, near-specular peaks, Fresnel at the critical angle,
                     // where 1 − F ∝ √(cos − cos_c)): compare where moving wi by 1e-6 moves
                     // the f64 value and density by less than 1e-4.
                     let (vp, pp) = lane.eval_pdf_out_of_line(
+                        &OwnColors,
                         wo_i.into(),
                         (wi_i + Vec3::splat(1e-6)).normalize().into(),
                         &mut free(),
@@ -906,6 +1031,7 @@ mod tests {
                         }
                     }
                     let s = lane.sample_out_of_line(
+                        &OwnColors,
                         wo_i.into(),
                         f32_in(u[i][0]),
                         f32_in(u[i][1]),

@@ -22,6 +22,7 @@ pub mod glint;
 pub mod il;
 pub mod kelemen;
 pub mod lambert;
+pub mod lane_colors;
 pub mod lane_models;
 pub mod multiple_scattering;
 pub mod oren_nayar;
@@ -31,6 +32,7 @@ pub mod rough_dielectric;
 pub use il::InterfacedLambertian;
 pub use kelemen::Kelemen;
 pub use lambert::Lambert;
+pub use lane_colors::{ColorSource, LaneColorParam, LaneColors, OwnColors};
 pub use lane_models::{LaneBsdf, LaneFresnel, LaneNdf, LaneRandom, LaneSample};
 pub use multiple_scattering::{
     CompensatedConductor, CompensatedDielectric, MultipleScatteringConductor,

@@ -10,7 +10,7 @@
 //! model group and bounce, nothing next to the model's own work.
 
 use facette_bsdf::lanes::{F32x8, F64x8, LVec3, Real};
-use facette_bsdf::models::{LaneBsdf, LaneRandom, LaneSample};
+use facette_bsdf::models::{ColorSource, LaneBsdf, LaneRandom, LaneSample};
 
 /// A lane type the kernel shades with, and how it calls the lane models: by default their
 /// baseline out-of-line functions.
@@ -19,24 +19,26 @@ pub(crate) trait ShadingLanes: Real {
     #[inline(always)]
     fn eval_pdf(
         model: &LaneBsdf,
+        colors: &impl ColorSource<Self>,
         wo: LVec3<Self>,
         wi: LVec3<Self>,
         rng: &mut impl LaneRandom<Self>,
     ) -> ([Self; 3], Self) {
-        model.eval_pdf_out_of_line(wo, wi, rng)
+        model.eval_pdf_out_of_line(colors, wo, wi, rng)
     }
 
     /// [`LaneBsdf::sample`], out of line.
     #[inline(always)]
     fn sample(
         model: &LaneBsdf,
+        colors: &impl ColorSource<Self>,
         wo: LVec3<Self>,
         u_lobe: Self,
         u0: Self,
         u1: Self,
         rng: &mut impl LaneRandom<Self>,
     ) -> LaneSample<Self> {
-        model.sample_out_of_line(wo, u_lobe, u0, u1, rng)
+        model.sample_out_of_line(colors, wo, u_lobe, u0, u1, rng)
     }
 }
 
@@ -49,6 +51,7 @@ impl ShadingLanes for F32x8 {
     #[inline(always)]
     fn eval_pdf(
         model: &LaneBsdf,
+        colors: &impl ColorSource<Self>,
         wo: LVec3<Self>,
         wi: LVec3<Self>,
         rng: &mut impl LaneRandom<Self>,
@@ -56,14 +59,15 @@ impl ShadingLanes for F32x8 {
         #[cfg(target_arch = "x86_64")]
         if avx2_fma() {
             // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { eval_pdf_avx2(model, wo, wi, rng) };
+            return unsafe { eval_pdf_avx2(model, colors, wo, wi, rng) };
         }
-        model.eval_pdf_out_of_line(wo, wi, rng)
+        model.eval_pdf_out_of_line(colors, wo, wi, rng)
     }
 
     #[inline(always)]
     fn sample(
         model: &LaneBsdf,
+        colors: &impl ColorSource<Self>,
         wo: LVec3<Self>,
         u_lobe: Self,
         u0: Self,
@@ -73,9 +77,9 @@ impl ShadingLanes for F32x8 {
         #[cfg(target_arch = "x86_64")]
         if avx2_fma() {
             // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { sample_avx2(model, wo, u_lobe, u0, u1, rng) };
+            return unsafe { sample_avx2(model, colors, wo, u_lobe, u0, u1, rng) };
         }
-        model.sample_out_of_line(wo, u_lobe, u0, u1, rng)
+        model.sample_out_of_line(colors, wo, u_lobe, u0, u1, rng)
     }
 }
 
@@ -92,11 +96,12 @@ pub(crate) fn avx2_fma() -> bool {
 #[inline(never)]
 fn eval_pdf_avx2(
     model: &LaneBsdf,
+    colors: &impl ColorSource<F32x8>,
     wo: LVec3<F32x8>,
     wi: LVec3<F32x8>,
     rng: &mut impl LaneRandom<F32x8>,
 ) -> ([F32x8; 3], F32x8) {
-    model.eval_pdf(wo, wi, rng)
+    model.eval_pdf_with(colors, wo, wi, rng)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -104,11 +109,12 @@ fn eval_pdf_avx2(
 #[inline(never)]
 fn sample_avx2(
     model: &LaneBsdf,
+    colors: &impl ColorSource<F32x8>,
     wo: LVec3<F32x8>,
     u_lobe: F32x8,
     u0: F32x8,
     u1: F32x8,
     rng: &mut impl LaneRandom<F32x8>,
 ) -> LaneSample<F32x8> {
-    model.sample(wo, u_lobe, u0, u1, rng)
+    model.sample_with(colors, wo, u_lobe, u0, u1, rng)
 }

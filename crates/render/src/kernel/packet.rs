@@ -19,8 +19,12 @@
 //! image sample for sample. The random numbers are the scalar integrator's, dimension for
 //! dimension, drawn eight lanes at a time ([`SampleLanes`]).
 //!
+//! A textured material with a lane model reads its textures lane by lane and runs its lane
+//! model with the values: textured colors as lanes beside the material's other lanes
+//! ([`LaneColors`]), a textured roughness as a model of the lane's own.
+//!
 //! What has no lane form runs lane by lane inside the same step, through the scalar code:
-//! materials without a lane model (and every textured or glint material) through their
+//! materials without a lane model (and glints) through their
 //! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than a constant environment and point
 //! lights, environment maps, area-light emission, ray differentials. On x86-64 the kernel
 //! is compiled twice, for the baseline (SSE2: an 8-lane f32 operation is two instructions)
@@ -33,7 +37,7 @@ use crate::geometry::{HitLanes, LaneRays, PacketHit, RayDifferential, Vec3};
 use crate::image::ConstantEnvironment;
 use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
 use crate::lights::{Environment, Light};
-use crate::materials::MaterialBsdf;
+use crate::materials::{LaneTexel, MaterialBsdf, SceneMaterial};
 use crate::render::{CameraSampling, PixelSums};
 use crate::sampler::lanes::SampleLanes;
 use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
@@ -41,7 +45,7 @@ use crate::scene::Scene;
 use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LFrame, LVec3, M64x8, Mask, Real, U32x8};
 use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
-use facette_bsdf::models::{LaneBsdf, LaneRandom};
+use facette_bsdf::models::{LaneBsdf, LaneColors, LaneRandom, OwnColors};
 use facette_bsdf::{BsdfContext, LobeFlags, Spectrum};
 use std::ops::Range;
 
@@ -136,12 +140,24 @@ struct Paths<S: Real> {
     segment: U32x8,
 }
 
-/// The ray queries' results of the current segment, kept across segments so that the
-/// queries write only the lanes that hit (see [`SceneGeometry::hit_lanes`]).
+/// The ray queries' results of the current segment and the materials at its hits, kept
+/// across segments so that the queries write only the lanes that hit (see
+/// [`SceneGeometry::hit_lanes`]) and a vertex writes only its live lanes' materials.
 #[derive(Default)]
-struct SegmentHits {
+struct SegmentHits<'s> {
     hits: [PacketHit; LANES],
     record: HitLanes,
+    vertex: VertexMaterials<'s>,
+}
+
+/// The textured lane materials' values at the hits of a segment: only the textured lanes'
+/// entries are written (and read).
+#[derive(Default)]
+struct LaneTexels {
+    /// A textured lane's colors ([`VertexBsdf::Lane`]).
+    colors: [LaneColors<f64>; LANES],
+    /// A lane's own model ([`VertexBsdf::Owned`]).
+    models: [Option<LaneBsdf>; LANES],
 }
 
 /// Up to eight camera rays, made together, waiting for lanes.
@@ -378,10 +394,27 @@ struct Kernel<'a> {
 /// model (then a model's group is found without comparing lanes) — found once, where the
 /// materials are looked up.
 struct VertexMaterials<'s> {
+    /// The live lanes' materials (the other lanes' are left from earlier vertices).
     bsdfs: [VertexBsdf<'s>; LANES],
     lane_models: Lanes,
     reads_lobe: Lanes,
     one_lane_model: bool,
+    /// The lanes of [`VertexBsdf::Lane`] whose colors are textured.
+    textured: Lanes,
+    texels: LaneTexels,
+}
+
+impl Default for VertexMaterials<'_> {
+    fn default() -> Self {
+        VertexMaterials {
+            bsdfs: std::array::from_fn(|_| VertexBsdf::None),
+            lane_models: 0,
+            reads_lobe: 0,
+            one_lane_model: true,
+            textured: 0,
+            texels: LaneTexels::default(),
+        }
+    }
 }
 
 impl VertexMaterials<'_> {
@@ -395,16 +428,44 @@ impl VertexMaterials<'_> {
             .filter(|&i| matches!(&self.bsdfs[i], VertexBsdf::Lane(m) if std::ptr::eq(*m, model)))
             .fold(0, |s, i| s | (1 << i))
     }
+
+    /// The lane model of `todo`'s first lane, the lanes of `todo` that share it, and
+    /// whether their colors are textured; `None` where `todo` is empty or its first lane
+    /// has no lane model.
+    #[inline(always)]
+    fn lane_group(&self, todo: Lanes) -> Option<(&LaneBsdf, Lanes, bool)> {
+        if todo == 0 {
+            return None;
+        }
+        let first = todo.trailing_zeros() as usize;
+        match &self.bsdfs[first] {
+            VertexBsdf::Lane(model) => {
+                let group = self.group_of(model, todo);
+                Some((model, group, group & self.textured != 0))
+            }
+            VertexBsdf::Owned => Some((self.texels.models[first].as_ref()?, 1 << first, false)),
+            _ => None,
+        }
+    }
+
+    /// The textured colors of the lanes, as lanes.
+    #[inline(always)]
+    fn lane_colors<S: Real>(&self) -> LaneColors<S> {
+        LaneColors::from_points(|i| &self.texels.colors[i])
+    }
 }
 
 /// One lane's material at a vertex.
 enum VertexBsdf<'s> {
     None,
+    /// A material's lane model (with the vertex's colors where the lane is textured).
     Lane(&'s LaneBsdf),
+    /// A lane model built for this lane (a textured roughness), in [`LaneTexels::models`].
+    Owned,
     Scalar(MaterialBsdf<'s>),
 }
 
-impl Kernel<'_> {
+impl<'s> Kernel<'s> {
     /// Fills the empty lanes with camera rays, making a new batch when the last is used up.
     #[inline(always)]
     fn refill<S: Real>(&self, paths: &mut Paths<S>, batch: &mut CameraBatch, jobs: &mut Jobs) {
@@ -552,7 +613,7 @@ impl Kernel<'_> {
     fn step<S: ShadingLanes>(
         &self,
         paths: &mut Paths<S>,
-        segment: &mut SegmentHits,
+        segment: &mut SegmentHits<'s>,
         sums: &mut [PixelSums],
     ) {
         let scene = self.scene;
@@ -579,42 +640,60 @@ impl Kernel<'_> {
             return;
         }
         // The materials.
-        let mut vertex = VertexMaterials {
-            bsdfs: std::array::from_fn(|_| VertexBsdf::None),
-            lane_models: 0,
-            reads_lobe: 0,
-            one_lane_model: true,
-        };
+        let vertex = &mut segment.vertex;
+        let (mut lane_models, mut reads_lobe, mut textured): (Lanes, Lanes, Lanes) = (0, 0, 0);
+        let mut one_lane_model = true;
         let mut first_model: Option<&LaneBsdf> = None;
         let mut smooth: Lanes = 0;
         let mut no_bsdf: Lanes = 0;
         for i in lanes_of(paths.live) {
             let material = scene.shape_material[hl.shape[i] as usize] as usize;
             let m = &scene.materials[material];
-            let bsdfs = &mut vertex.bsdfs;
-            bsdfs[i] = match m.lane_bsdf() {
+            vertex.bsdfs[i] = match m.lane_bsdf() {
                 Some(lane) => {
-                    vertex.lane_models |= 1 << i;
+                    let bsdf = if m.is_textured() {
+                        let (uv, derivs) = self.surface_details(paths, hl, m, i);
+                        match m.lane_texel(uv, derivs) {
+                            Some(LaneTexel::Colors(c)) => {
+                                vertex.texels.colors[i] = c;
+                                textured |= 1 << i;
+                                VertexBsdf::Lane(lane)
+                            }
+                            Some(LaneTexel::Model(own)) => {
+                                one_lane_model = false;
+                                vertex.texels.models[i] = Some(own);
+                                VertexBsdf::Owned
+                            }
+                            None => {
+                                no_bsdf |= 1 << i;
+                                continue;
+                            }
+                        }
+                    } else {
+                        VertexBsdf::Lane(lane)
+                    };
+                    lane_models |= 1 << i;
                     if lane.reads_lobe_number() {
-                        vertex.reads_lobe |= 1 << i;
+                        reads_lobe |= 1 << i;
                     }
                     match first_model {
                         None => first_model = Some(lane),
-                        Some(f) => vertex.one_lane_model &= std::ptr::eq(f, lane),
+                        Some(f) => one_lane_model &= std::ptr::eq(f, lane),
                     }
-                    VertexBsdf::Lane(lane)
+                    if lane.flags().has_smooth_part() {
+                        smooth |= 1 << i;
+                    }
+                    bsdf
                 }
                 None => {
-                    let mut hit = hl.surface_hit(i);
-                    let mut derivs = [0.0; 4];
-                    if m.reads_surface_details() {
-                        scene.geometry.complete_hit(&mut hit);
-                        if let (Some(d), 1) = (&paths.rd[i], paths.segment.lane(i)) {
-                            derivs = hit.uv_derivatives(d);
+                    let (uv, derivs) = self.surface_details(paths, hl, m, i);
+                    match m.bsdf(uv, derivs) {
+                        Some(b) => {
+                            if b.flags().has_smooth_part() {
+                                smooth |= 1 << i;
+                            }
+                            VertexBsdf::Scalar(b)
                         }
-                    }
-                    match m.bsdf(hit.uv, derivs) {
-                        Some(b) => VertexBsdf::Scalar(b),
                         None => {
                             no_bsdf |= 1 << i;
                             continue;
@@ -622,18 +701,15 @@ impl Kernel<'_> {
                     }
                 }
             };
-            let flags = match &vertex.bsdfs[i] {
-                VertexBsdf::Lane(l) => l.flags(),
-                VertexBsdf::Scalar(b) => b.flags(),
-                VertexBsdf::None => LobeFlags::NONE,
-            };
-            if flags.has_smooth_part() {
-                smooth |= 1 << i;
-            }
         }
         if no_bsdf != 0 {
             Self::finish(paths, no_bsdf, sums);
         }
+        vertex.lane_models = lane_models;
+        vertex.reads_lobe = reads_lobe;
+        vertex.one_lane_model = one_lane_model;
+        vertex.textured = textured;
+        let vertex = &segment.vertex;
         let frame = LFrame::from_normal_tangent(hl.ns, hl.dpdu);
         let wo = vec_s::<S>(frame.to_local(-paths.d));
         let block = paths
@@ -642,9 +718,30 @@ impl Kernel<'_> {
             .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
             .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
         if self.strategy != Strategy::BsdfOnly {
-            self.next_event(paths, hl, &frame, wo, &vertex, smooth & paths.live, block);
+            self.next_event(paths, hl, &frame, wo, vertex, smooth & paths.live, block);
         }
-        self.continue_paths(paths, hl, &frame, wo, &vertex, block, sums);
+        self.continue_paths(paths, hl, &frame, wo, vertex, block, sums);
+    }
+
+    /// Lane `i`'s texture coordinates and footprint where its material `m` reads them (what
+    /// the scalar integrator computes at the same hit), zeros otherwise.
+    #[inline(always)]
+    fn surface_details<S: Real>(
+        &self,
+        paths: &Paths<S>,
+        hl: &HitLanes,
+        m: &SceneMaterial,
+        i: usize,
+    ) -> (crate::geometry::Vec2, [f64; 4]) {
+        let mut hit = hl.surface_hit(i);
+        let mut derivs = [0.0; 4];
+        if m.reads_surface_details() {
+            self.scene.geometry.complete_hit(&mut hit);
+            if let (Some(d), 1) = (&paths.rd[i], paths.segment.lane(i)) {
+                derivs = hit.uv_derivatives(d);
+            }
+        }
+        (hit.uv, derivs)
     }
 
     /// Emission seen by the rays of `missed` leaving the scene.
@@ -920,22 +1017,26 @@ impl Kernel<'_> {
         let cos = wi.z.abs();
         let mut todo = set;
         while todo != 0 {
+            if let Some((model, group, textured)) = vertex.lane_group(todo) {
+                todo &= !group;
+                let mut free = FreeNumbers {
+                    streams: &mut paths.streams,
+                    sampler: self.sampler,
+                    group,
+                };
+                let (v, p) = if textured {
+                    S::eval_pdf(model, &vertex.lane_colors::<S>(), wo, wi, &mut free)
+                } else {
+                    S::eval_pdf(model, &OwnColors, wo, wi, &mut free)
+                };
+                for c in 0..3 {
+                    f[c] = merge(group, v[c] * cos, f[c]);
+                }
+                *pdf = merge(group, p, *pdf);
+                continue;
+            }
             let first = todo.trailing_zeros() as usize;
             match &vertex.bsdfs[first] {
-                VertexBsdf::Lane(model) => {
-                    let group = vertex.group_of(model, todo);
-                    todo &= !group;
-                    let mut free = FreeNumbers {
-                        streams: &mut paths.streams,
-                        sampler: self.sampler,
-                        group,
-                    };
-                    let (v, p) = S::eval_pdf(model, wo, wi, &mut free);
-                    for c in 0..3 {
-                        f[c] = merge(group, v[c] * cos, f[c]);
-                    }
-                    *pdf = merge(group, p, *pdf);
-                }
                 VertexBsdf::Scalar(bsdf) => {
                     todo &= !(1 << first);
                     let ctx = BsdfContext::RADIANCE;
@@ -948,7 +1049,7 @@ impl Kernel<'_> {
                         *pdf = S::from_fn(|j| if j == first { p } else { pdf.lane(j) });
                     }
                 }
-                VertexBsdf::None => todo &= !(1 << first),
+                _ => todo &= !(1 << first),
             }
         }
     }
@@ -1000,18 +1101,19 @@ impl Kernel<'_> {
                 true,
             );
             let mut todo = lane_set;
-            while todo != 0 {
-                let VertexBsdf::Lane(model) = &vertex.bsdfs[todo.trailing_zeros() as usize] else {
-                    unreachable!("a lane-model lane");
-                };
-                let group = vertex.group_of(model, todo);
+            while let Some((model, group, textured)) = vertex.lane_group(todo) {
                 todo &= !group;
                 let mut free = FreeNumbers {
                     streams: &mut paths.streams,
                     sampler: self.sampler,
                     group,
                 };
-                let s = S::sample(model, wo, u_lobe, u0, u1, &mut free);
+                let s = if textured {
+                    let colors = vertex.lane_colors::<S>();
+                    S::sample(model, &colors, wo, u_lobe, u0, u1, &mut free)
+                } else {
+                    S::sample(model, &OwnColors, wo, u_lobe, u0, u1, &mut free)
+                };
                 let m = mask::<S>(group);
                 wi = LVec3::select(m, s.wi, wi);
                 for (w, sw) in weight.iter_mut().zip(s.weight) {
@@ -1170,16 +1272,22 @@ mod tests {
         width = 24
         height = 16
         [materials]
-        floor = { type = "lambert", reflectance = 0.5 }
+        floor = { type = "lambert", reflectance = { texture = "checker", a = [0.2, 0.3, 0.4], b = 0.8, scale = 6 } }
         gold = { type = "conductor", distribution = "ggx", alpha = 0.3, material = "Au" }
-        glass = { type = "dielectric", distribution = "beckmann", alpha = 0.3, ior = 1.5 }
+        glass = { type = "dielectric", distribution = "beckmann", alpha = 0.3, ior = 1.5, specular_transmittance = { texture = "checker", a = 0.6, b = [1.0, 0.9, 0.8], scale = 5 } }
         clay = { type = "oren-nayar", reflectance = 0.6, sigma = 0.35 }
-        plastic = { type = "il", kd = [0.7, 0.28, 0.1], ni = 1.5, distribution = "beckmann", alpha = 0.3, masking = "smith" }
+        plastic = { type = "il", kd = { texture = "checker", a = [0.7, 0.28, 0.1], b = [0.1, 0.5, 0.9], scale = 4 }, ni = 1.5, distribution = "beckmann", alpha = 0.3, masking = "smith" }
+        brushed = { type = "conductor", distribution = "beckmann", alpha_u = { texture = "checker", a = 0.1, b = 0.5, scale = 4 }, alpha_v = 0.3, material = "Al", specular_reflectance = { texture = "checker", a = 0.7, b = 1.0, scale = 3 } }
         [[objects]]
         shape = "sphere"
         center = [0.5, 0.7, -0.6]
         radius = 0.4
         material = "plastic"
+        [[objects]]
+        shape = "sphere"
+        center = [-0.6, 0.8, -0.5]
+        radius = 0.35
+        material = "brushed"
         [[objects]]
         shape = "rectangle"
         transform = [{ rotate = { axis = [1, 0, 0], angle = -90 } }, { scale = 4 }, { translate = [0, -0.5, 0] }]
@@ -1216,10 +1324,18 @@ mod tests {
     /// every pixel agrees to 1e-9 for every sampler and estimator (the lane models differ
     /// from the f64 models only in how they write the sampling weight and the dielectric's
     /// Fresnel term; the stochastic IL body draws the same free-stream numbers); f32 lanes
-    /// render every sample too.
+    /// render every sample too. Textured lane materials (colors of Lambert, IL, a dielectric
+    /// and a conductor, a conductor's roughness) run their lane models with the textures'
+    /// values, where the scalar integrator rebuilds their f64 models.
     #[test]
     fn f64_lanes_reproduce_the_scalar_integrator_sample_for_sample() {
         let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
+        let textured_lane_models = scene
+            .materials
+            .iter()
+            .filter(|m| m.is_textured() && m.lane_bsdf().is_some())
+            .count();
+        assert_eq!(textured_lane_models, 4);
         let (w, h) = (scene.film.width, scene.film.height);
         let cameras = CameraSampling {
             footprints: false,

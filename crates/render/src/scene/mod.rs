@@ -67,6 +67,26 @@ pub struct Scene {
     pub warnings: Vec<String>,
 }
 
+impl Scene {
+    /// What went wrong at shading points during renders so far, one line per material: the
+    /// points whose textured values were not valid parameters (non-finite texels), where
+    /// the paths ended.
+    pub fn shading_warnings(&self) -> Vec<String> {
+        self.materials
+            .iter()
+            .filter(|m| m.failed_shading_points() > 0)
+            .map(|m| {
+                format!(
+                    "material `{}`: {} shading points had texture values that are not valid \
+                     parameters; their paths ended there",
+                    m.name,
+                    m.failed_shading_points()
+                )
+            })
+            .collect()
+    }
+}
+
 /// How to load a scene file.
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {

@@ -142,6 +142,26 @@ pub struct InterfacedLambertian {
     ms_quadrature: Option<Arc<VCavityQuadrature>>,
 }
 
+/// K_d/(n_i² (1 − K_d r_i)) per channel: the body's factor in IL18 eq. 13 (r_i the internal
+/// diffuse reflectance of the interface).
+pub(crate) fn body_factor(kd: Spectrum, ni: f64, ri: f64) -> Spectrum {
+    kd.map(|k| k / (ni * ni * (1.0 - k * ri)))
+}
+
+/// The probability of sampling the specular lobe of rough IL [IL18 §4.1]: the specular
+/// albedo r_e against it plus the body's (1 − r_e)² K̄_d/(n_i² (1 − K̄_d r_i)), K̄_d the
+/// channel average.
+pub(crate) fn specular_probability(kd: Spectrum, ni: f64, re: f64, ri: f64) -> f64 {
+    let kbar = kd.average();
+    let rs = re;
+    let rb = (1.0 - re) * (1.0 - re) * kbar / (ni * ni * (1.0 - kbar * ri));
+    if rs + rb > 0.0 {
+        rs / (rs + rb)
+    } else {
+        1.0
+    }
+}
+
 impl InterfacedLambertian {
     pub fn new(
         kd: Spectrum,
@@ -154,7 +174,7 @@ impl InterfacedLambertian {
         check_range("ni", ni, 1.0, 10.0, Bounds::Closed)?;
         let re = external_diffuse_reflectance(ni);
         let ri = internal_diffuse_reflectance(ni);
-        let body_factor = kd.map(|k| k / (ni * ni * (1.0 - k * ri)));
+        let body_factor = body_factor(kd, ni, ri);
         if let BodyEvaluation::Quadrature { samples } = evaluation {
             check_min_count("samples", samples, 8)?;
         }
@@ -180,10 +200,7 @@ impl InterfacedLambertian {
         if let (BodyEvaluation::Table(t), Some(l)) = (&evaluation, &lobe) {
             t.check_matches(ni, l)?;
         }
-        let kbar = kd.average();
-        let rs = re;
-        let rb = (1.0 - re) * (1.0 - re) * kbar / (ni * ni * (1.0 - kbar * ri));
-        let specular_probability = if rs + rb > 0.0 { rs / (rs + rb) } else { 1.0 };
+        let specular_probability = specular_probability(kd, ni, re, ri);
         Ok(InterfacedLambertian {
             kd,
             ni,
@@ -229,6 +246,11 @@ impl InterfacedLambertian {
 
     pub fn kd(&self) -> Spectrum {
         self.kd
+    }
+
+    /// The interface's external and internal diffuse reflectances (r_e, r_i).
+    pub fn diffuse_reflectances(&self) -> (f64, f64) {
+        (self.re, self.ri)
     }
 
     pub fn ni(&self) -> f64 {
