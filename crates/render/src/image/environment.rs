@@ -164,7 +164,10 @@ fn odd_sin_moment(c: f64) -> f64 {
 /// (a, a + c ∈ [0, π]), with its closed-form CDF.
 #[derive(Clone, Copy, Debug)]
 struct PatchRow {
-    a: f64,
+    /// sin a and cos a: the map keeps them per patch row, so that a point of the row costs
+    /// one `sin_cos` (of h, below) instead of two.
+    sin_a: f64,
+    cos_a: f64,
     c: f64,
     top: f64,
     bottom: f64,
@@ -179,17 +182,30 @@ struct RowPoint {
 }
 
 impl PatchRow {
+    /// The row from a = π v₀ and c = π Δv.
+    fn new(a: f64, c: f64, top: f64, bottom: f64) -> PatchRow {
+        let (sin_a, cos_a) = sin_cos(a);
+        PatchRow {
+            sin_a,
+            cos_a,
+            c,
+            top,
+            bottom,
+        }
+    }
+
     /// The mass on [0, t₁] and the density at t₁, from the moments about the midpoint
     /// m = a + h, h = c t₁ / 2, so that neither cancels for small c:
     /// ∫₀¹ sin(a + c t₁ r) dr = sin m · sinc h and ∫₀¹ r sin(a + c t₁ r) dr = half of it +
     /// cos m · ∫ τ sin(c t₁ τ) dτ; top ∫₀^t₁ (1 − t) sin + bottom ∫₀^t₁ t sin are two
-    /// non-negative terms. One `sin_cos` of m and one of h give these and the sines at both
-    /// ends, sin(m ± h).
+    /// non-negative terms. The `sin_cos` of h and the row's sin a, cos a give these (m's by
+    /// the angle-sum formulas) and the sines at both ends, sin(m ± h).
     #[inline]
     fn at(&self, t1: f64) -> RowPoint {
         let h = 0.5 * self.c * t1;
-        let (sm, cm) = sin_cos(self.a + h);
         let (sh, ch) = sin_cos(h);
+        let (sa, ca) = (self.sin_a, self.cos_a);
+        let (sm, cm) = (sa * ch + ca * sh, ca * ch - sa * sh);
         let sinc = if h == 0.0 { 1.0 } else { sh / h };
         let p0 = sm * sinc;
         let p1 = 0.5 * p0 + cm * odd_sin_moment(self.c * t1);
@@ -199,7 +215,7 @@ impl PatchRow {
         RowPoint {
             cdf: self.top * lo + self.bottom * hi,
             density: ((1.0 - t1) * self.top + t1 * self.bottom) * sin_end,
-            sin_start: (sm * ch - cm * sh).max(0.0),
+            sin_start: sa.max(0.0),
         }
     }
 
@@ -249,7 +265,7 @@ impl PatchRow {
 /// The mass on t ∈ [0, t₁] of (1 − t) top + t bottom, times sin(a + c t).
 #[inline]
 fn patch_row_cdf(a: f64, c: f64, top: f64, bottom: f64, t1: f64) -> f64 {
-    PatchRow { a, c, top, bottom }.at(t1).cdf
+    PatchRow::new(a, c, top, bottom).at(t1).cdf
 }
 
 /// The four pixels around a point of the map (upper left, upper right, lower left, lower
@@ -285,6 +301,8 @@ pub struct EnvironmentMap {
     distribution: Distribution2D,
     /// 1 / (2π² Σ weights) = 1 / ∫Y dω (unscaled); 0 for a black map.
     inv_integral: f64,
+    /// sin a and cos a of each patch row (a = π v₀), for [`PatchRow`].
+    row_angles: Vec<(f64, f64)>,
     mean: Spectrum,
 }
 
@@ -341,9 +359,11 @@ impl EnvironmentMap {
         // bottom the means of the patch's two upper and two lower corners.
         let du = 1.0 / w as f64;
         let mut weights = vec![0.0; w * (h + 1)];
+        let mut row_angles = Vec::with_capacity(h + 1);
         for j in 0..=h {
             let (ra, rb, v0, dv) = patch_row(j, h);
             let (a, c) = (PI * v0, PI * dv);
+            row_angles.push(sin_cos(a));
             let (upper, lower) = (image.row(ra), image.row(rb));
             for x in 0..w {
                 let xb = if x + 1 == w { 0 } else { x + 1 };
@@ -387,6 +407,7 @@ impl EnvironmentMap {
             scale,
             distribution,
             inv_integral,
+            row_angles,
             mean,
         })
     }
@@ -520,8 +541,10 @@ impl EnvironmentMap {
         let (l01, l11) = (corner(x, rb), corner(xb, rb));
         // v from the marginal, linear in v (the means of the upper and lower corners) times
         // sin(πv); then u from the linear conditional at that v.
+        let (sin_a, cos_a) = self.row_angles[j];
         let row = PatchRow {
-            a: PI * v0,
+            sin_a,
+            cos_a,
             c: PI * dv,
             top: 0.5 * (l00 + l10),
             bottom: 0.5 * (l01 + l11),
@@ -732,7 +755,7 @@ mod tests {
                 let total = patch_row_cdf(a, c, top, bottom, 1.0);
                 for k in 0..=64 {
                     let xi = (k as f64 / 64.0).min(ONE_MINUS_EPS);
-                    let row = PatchRow { a, c, top, bottom };
+                    let row = PatchRow::new(a, c, top, bottom);
                     let t = row.sample(xi);
                     assert!((0.0..1.0).contains(&t));
                     let f = patch_row_cdf(a, c, top, bottom, t) / total;
