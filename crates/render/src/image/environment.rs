@@ -164,13 +164,36 @@ fn odd_sin_moment(c: f64) -> f64 {
 /// (a, a + c ∈ [0, π]), with its closed-form CDF.
 #[derive(Clone, Copy, Debug)]
 struct PatchRow {
-    /// sin a and cos a: the map keeps them per patch row, so that a point of the row costs
-    /// one `sin_cos` (of h, below) instead of two.
-    sin_a: f64,
-    cos_a: f64,
+    angles: RowAngles,
     c: f64,
     top: f64,
     bottom: f64,
+}
+
+/// What a patch row's points share, kept by the map per row: sin a and cos a, so that a
+/// point costs one `sin_cos` (of h, see [`PatchRow::at`]) instead of two, and the row's end
+/// (t₁ = 1, which every draw reads) none: sin and cos of c/2 and ∫ τ sin(cτ) dτ.
+#[derive(Clone, Copy, Debug)]
+struct RowAngles {
+    sin_a: f64,
+    cos_a: f64,
+    sin_half_c: f64,
+    cos_half_c: f64,
+    odd_c: f64,
+}
+
+impl RowAngles {
+    fn new(a: f64, c: f64) -> RowAngles {
+        let (sin_a, cos_a) = sin_cos(a);
+        let (sin_half_c, cos_half_c) = sin_cos(0.5 * c);
+        RowAngles {
+            sin_a,
+            cos_a,
+            sin_half_c,
+            cos_half_c,
+            odd_c: odd_sin_moment(c),
+        }
+    }
 }
 
 /// What [`PatchRow::at`] gives: the CDF at t₁, the density at t₁, and sin a (the density's
@@ -184,10 +207,8 @@ struct RowPoint {
 impl PatchRow {
     /// The row from a = π v₀ and c = π Δv.
     fn new(a: f64, c: f64, top: f64, bottom: f64) -> PatchRow {
-        let (sin_a, cos_a) = sin_cos(a);
         PatchRow {
-            sin_a,
-            cos_a,
+            angles: RowAngles::new(a, c),
             c,
             top,
             bottom,
@@ -204,11 +225,24 @@ impl PatchRow {
     fn at(&self, t1: f64) -> RowPoint {
         let h = 0.5 * self.c * t1;
         let (sh, ch) = sin_cos(h);
-        let (sa, ca) = (self.sin_a, self.cos_a);
+        self.point(t1, h, sh, ch, odd_sin_moment(self.c * t1))
+    }
+
+    /// [`at`](Self::at)`(1)` from the row's kept angles.
+    #[inline]
+    fn end(&self) -> RowPoint {
+        let g = &self.angles;
+        self.point(1.0, 0.5 * self.c, g.sin_half_c, g.cos_half_c, g.odd_c)
+    }
+
+    /// [`at`](Self::at)`(t1)` given h = c t₁/2, sin h, cos h and ∫ τ sin(c t₁ τ) dτ.
+    #[inline]
+    fn point(&self, t1: f64, h: f64, sh: f64, ch: f64, odd: f64) -> RowPoint {
+        let (sa, ca) = (self.angles.sin_a, self.angles.cos_a);
         let (sm, cm) = (sa * ch + ca * sh, ca * ch - sa * sh);
         let sinc = if h == 0.0 { 1.0 } else { sh / h };
         let p0 = sm * sinc;
-        let p1 = 0.5 * p0 + cm * odd_sin_moment(self.c * t1);
+        let p1 = 0.5 * p0 + cm * odd;
         let lo = (t1 * (p0 - t1 * p1)).max(0.0);
         let hi = (t1 * t1 * p1).max(0.0);
         let sin_end = (sm * ch + cm * sh).max(0.0);
@@ -225,7 +259,7 @@ impl PatchRow {
     /// an error far below f64's resolution of t and ends the iteration (usually after two
     /// evaluations; one more would only confirm it).
     fn sample(&self, xi: f64) -> f64 {
-        let end = self.at(1.0);
+        let end = self.end();
         let total = end.cdf;
         if !(total > 0.0) {
             return xi;
@@ -301,8 +335,8 @@ pub struct EnvironmentMap {
     distribution: Distribution2D,
     /// 1 / (2π² Σ weights) = 1 / ∫Y dω (unscaled); 0 for a black map.
     inv_integral: f64,
-    /// sin a and cos a of each patch row (a = π v₀), for [`PatchRow`].
-    row_angles: Vec<(f64, f64)>,
+    /// What the points of each patch row share ([`PatchRow`]).
+    row_angles: Vec<RowAngles>,
     mean: Spectrum,
 }
 
@@ -363,7 +397,7 @@ impl EnvironmentMap {
         for j in 0..=h {
             let (ra, rb, v0, dv) = patch_row(j, h);
             let (a, c) = (PI * v0, PI * dv);
-            row_angles.push(sin_cos(a));
+            row_angles.push(RowAngles::new(a, c));
             let (upper, lower) = (image.row(ra), image.row(rb));
             for x in 0..w {
                 let xb = if x + 1 == w { 0 } else { x + 1 };
@@ -541,10 +575,8 @@ impl EnvironmentMap {
         let (l01, l11) = (corner(x, rb), corner(xb, rb));
         // v from the marginal, linear in v (the means of the upper and lower corners) times
         // sin(πv); then u from the linear conditional at that v.
-        let (sin_a, cos_a) = self.row_angles[j];
         let row = PatchRow {
-            sin_a,
-            cos_a,
+            angles: self.row_angles[j],
             c: PI * dv,
             top: 0.5 * (l00 + l10),
             bottom: 0.5 * (l01 + l11),
@@ -756,6 +788,12 @@ mod tests {
                 for k in 0..=64 {
                     let xi = (k as f64 / 64.0).min(ONE_MINUS_EPS);
                     let row = PatchRow::new(a, c, top, bottom);
+                    // The kept end is the computed one, to the bit.
+                    let (end, at_one) = (row.end(), row.at(1.0));
+                    assert_eq!(
+                        (end.cdf, end.density, end.sin_start),
+                        (at_one.cdf, at_one.density, at_one.sin_start)
+                    );
                     let t = row.sample(xi);
                     assert!((0.0..1.0).contains(&t));
                     let f = patch_row_cdf(a, c, top, bottom, t) / total;
