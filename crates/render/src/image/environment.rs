@@ -205,7 +205,8 @@ struct RowPoint {
 }
 
 impl PatchRow {
-    /// The row from a = π v₀ and c = π Δv.
+    /// The row from a = π v₀ and c = π Δv (the map makes its rows from the angles it keeps).
+    #[cfg(test)]
     fn new(a: f64, c: f64, top: f64, bottom: f64) -> PatchRow {
         PatchRow {
             angles: RowAngles::new(a, c),
@@ -297,7 +298,7 @@ impl PatchRow {
 }
 
 /// The mass on t ∈ [0, t₁] of (1 − t) top + t bottom, times sin(a + c t).
-#[inline]
+#[cfg(test)]
 fn patch_row_cdf(a: f64, c: f64, top: f64, bottom: f64, t1: f64) -> f64 {
     PatchRow::new(a, c, top, bottom).at(t1).cdf
 }
@@ -397,13 +398,20 @@ impl EnvironmentMap {
         for j in 0..=h {
             let (ra, rb, v0, dv) = patch_row(j, h);
             let (a, c) = (PI * v0, PI * dv);
-            row_angles.push(RowAngles::new(a, c));
+            let angles = RowAngles::new(a, c);
+            row_angles.push(angles);
             let (upper, lower) = (image.row(ra), image.row(rb));
             for x in 0..w {
                 let xb = if x + 1 == w { 0 } else { x + 1 };
                 let top = 0.5 * (luminance(upper[x]) + luminance(upper[xb]));
                 let bottom = 0.5 * (luminance(lower[x]) + luminance(lower[xb]));
-                weights[j * w + x] = du * dv * patch_row_cdf(a, c, top, bottom, 1.0);
+                let row = PatchRow {
+                    angles,
+                    c,
+                    top,
+                    bottom,
+                };
+                weights[j * w + x] = du * dv * row.end().cdf;
             }
         }
         let distribution = Distribution2D::new(w, h + 1, &weights);
