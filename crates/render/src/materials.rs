@@ -39,6 +39,14 @@ struct TexturedParam {
     lane: Option<LaneTarget>,
 }
 
+impl TexturedParam {
+    /// A colour texture's value at a shading point, held to [0, 1].
+    #[inline]
+    fn spectrum_at(&self, uv: DVec2, derivs: [f64; 4]) -> Spectrum {
+        self.texture.eval(uv, derivs).map(|x| x.clamp(0.0, 1.0))
+    }
+}
+
 /// A texture's parameter in a lane model.
 #[derive(Clone, Copy, Debug)]
 enum LaneTarget {
@@ -235,7 +243,7 @@ impl SceneMaterial {
         for t in &self.textures {
             match t.lane? {
                 LaneTarget::Color(param) => {
-                    let v = t.texture.eval(uv, derivs).map(|x| x.clamp(0.0, 1.0));
+                    let v = t.spectrum_at(uv, derivs);
                     if !v.0.iter().all(|x| x.is_finite()) {
                         return self.failed();
                     }
@@ -244,12 +252,13 @@ impl SceneMaterial {
                 LaneTarget::Roughness => {
                     // Held to the range validated at load time (filtering stays inside it
                     // but for rounding).
+                    // (A NaN stays NaN, which `with_roughness` refuses.)
                     let (lo, hi) = t.range;
-                    let v = t.texture.eval_scalar(uv, derivs);
+                    let v = t.texture.eval_scalar(uv, derivs).clamp(lo, hi);
                     let base = rough.as_ref().unwrap_or(model);
-                    match base.with_roughness(t.key, v.clamp(lo, hi)) {
-                        Ok(m) if v.is_finite() => rough = Some(m),
-                        _ => return self.failed(),
+                    match base.with_roughness(t.key, v) {
+                        Ok(m) => rough = Some(m),
+                        Err(_) => return self.failed(),
                     }
                 }
             }
@@ -303,8 +312,7 @@ impl SceneMaterial {
         let mut r = self.recipe.clone();
         for t in &self.textures {
             let ok = if t.spectrum {
-                let v = t.texture.eval(uv, derivs).map(|x| x.clamp(0.0, 1.0));
-                r.set_spectrum(t.key, v).is_ok()
+                r.set_spectrum(t.key, t.spectrum_at(uv, derivs)).is_ok()
             } else {
                 r.set_scalar(t.key, t.texture.eval_scalar(uv, derivs))
                     .is_ok()

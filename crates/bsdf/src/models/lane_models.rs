@@ -220,11 +220,6 @@ fn mirror<R: Real>(w: LVec3<R>, s: R) -> LVec3<R> {
     LVec3::new(w.x, w.y, w.z * s)
 }
 
-#[inline(always)]
-fn tinted<R: Real>(tint: &[R; 3], v: R) -> [R; 3] {
-    std::array::from_fn(|c| tint[c] * v)
-}
-
 /// Malley's cosine-weighted hemisphere from Shirley–Chiu's concentric disk (the f64
 /// `square_to_cosine_hemisphere`).
 #[inline(always)]
@@ -324,8 +319,8 @@ impl LaneBsdf {
             LaneBsdf::Lambert { reflectance } => {
                 let same = (wo.z * wi.z).gt(R::zero());
                 let pdf = R::masked(same, wi.z.abs() * R::splat(INV_PI));
-                let reflectance = colors.tint(reflectance);
-                (tinted(&reflectance, R::masked(same, R::splat(INV_PI))), pdf)
+                let v = R::masked(same, R::splat(INV_PI));
+                (colors.tint(reflectance).map(|r| r * v), pdf)
             }
             LaneBsdf::Conductor { ndf, fresnel, tint } => {
                 let tint = colors.tint(tint);
