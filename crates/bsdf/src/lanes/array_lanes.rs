@@ -4,20 +4,33 @@
 //! [`array_lanes!`] for [`F32x8`](super::F32x8) and [`F64x4`](super::F64x4). Each type adds
 //! its own transcendental functions.
 
-/// `[f(a[0]), …, f(a[N−1])]`: the length comes from the input array.
+/// `[f(a[0]), …, f(a[N−1])]`: the length comes from the input array. A loop over a zeroed
+/// array rather than `std::array::from_fn`, whose initialization guard LLVM does not
+/// always remove (measured: 2,124 against 2,102 instructions a sample on `bench-sphere`).
 #[inline(always)]
-pub(crate) fn map1<T: Copy, U, const N: usize>(a: [T; N], f: impl Fn(T) -> U) -> [U; N] {
-    std::array::from_fn(|i| f(a[i]))
+pub(crate) fn map1<T: Copy, U: Copy + Default, const N: usize>(
+    a: [T; N],
+    f: impl Fn(T) -> U,
+) -> [U; N] {
+    let mut r = [U::default(); N];
+    for i in 0..N {
+        r[i] = f(a[i]);
+    }
+    r
 }
 
 /// `[f(a[0], b[0]), …]`.
 #[inline(always)]
-pub(crate) fn map2<T: Copy, S: Copy, U, const N: usize>(
+pub(crate) fn map2<T: Copy, S: Copy, U: Copy + Default, const N: usize>(
     a: [T; N],
     b: [S; N],
     f: impl Fn(T, S) -> U,
 ) -> [U; N] {
-    std::array::from_fn(|i| f(a[i], b[i]))
+    let mut r = [U::default(); N];
+    for i in 0..N {
+        r[i] = f(a[i], b[i]);
+    }
+    r
 }
 
 /// `lanewise!(a, |x| e)` is [`map1`], `lanewise!(a, b, |x, y| e)` is [`map2`].
@@ -116,6 +129,20 @@ macro_rules! array_lanes {
             fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
                 $mask(std::array::from_fn(|i| if f(i) { !0 } else { 0 }))
             }
+            #[inline(always)]
+            fn lane_bits(self) -> u32 {
+                self.bits()
+            }
+            #[inline(always)]
+            fn from_lane_bits(bits: u32) -> Self {
+                $mask(std::array::from_fn(|i| {
+                    <$bits>::MIN.wrapping_sub(((bits >> i) & 1) as $bits)
+                }))
+            }
+            #[inline(always)]
+            fn width() -> usize {
+                $n
+            }
         }
 
         impl $real {
@@ -150,6 +177,12 @@ macro_rules! array_lanes {
             #[inline(always)]
             fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
                 $real(std::array::from_fn(|i| f(i) as $elem))
+            }
+            /// In place: a scalar store to the lane (rebuilding the whole value, read back
+            /// at once as a vector, stalled store forwarding in the kernel's refill).
+            #[inline(always)]
+            fn set_lane(&mut self, i: usize, v: f64) {
+                self.0[i] = v as $elem;
             }
             /// One load of the cell's four numbers per lane, transposed into four lane values.
             #[inline(always)]

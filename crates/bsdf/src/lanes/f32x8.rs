@@ -114,7 +114,9 @@ array_lanes!(
                 p = p * r + F32x8::splat(c);
             }
             let y = p * r * r + r + F32x8::one();
-            let scale = Self::from_bits(lanewise!(ni.0, |e| ((e + 127) as u32) << 23));
+            // Wrapping: the release profile checks overflow, and a checked add per lane is a
+            // branch per lane that keeps the loop from vectorizing (|n| ≤ 127 here).
+            let scale = Self::from_bits(lanewise!(ni.0, |e| (e.wrapping_add(127) as u32) << 23));
             let out = y * scale;
             // A NaN input stays NaN (the clamp above would have turned it into a number).
             Self::select(self.eq(self), out, self)
@@ -126,7 +128,7 @@ array_lanes!(
         #[inline(always)]
         fn ln(self) -> Self {
             let b = self.bits();
-            let e = lanewise!(b, |v| ((v >> 23) & 0xFF) as i32 - 126);
+            let e = lanewise!(b, |v| (((v >> 23) & 0xFF) as i32).wrapping_sub(126));
             let m = Self::from_bits(lanewise!(b, |v| (v & 0x807F_FFFF) | 0x3F00_0000));
             // m in [0.5, 1): fold below √½ into [√½, √2) by doubling.
             let small = m.lt(F32x8::splat(std::f64::consts::FRAC_1_SQRT_2));

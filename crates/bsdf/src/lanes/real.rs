@@ -22,6 +22,25 @@ pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output
     }
     fn lane(self, i: usize) -> bool;
     fn from_fn(f: impl FnMut(usize) -> bool) -> Self;
+    /// One bit per lane, lane `i` in bit `i` (AVX's `movemask`).
+    #[inline(always)]
+    fn lane_bits(self) -> u32 {
+        let mut b = 0;
+        for i in 0..32 {
+            if i == Self::width() {
+                break;
+            }
+            b |= (self.lane(i) as u32) << i;
+        }
+        b
+    }
+    /// The mask with lane `i` set where bit `i` of `bits` is.
+    #[inline(always)]
+    fn from_lane_bits(bits: u32) -> Self {
+        Self::from_fn(|i| bits & (1 << i) != 0)
+    }
+    /// Lanes per mask.
+    fn width() -> usize;
 }
 
 impl Mask for bool {
@@ -44,6 +63,10 @@ impl Mask for bool {
     #[inline(always)]
     fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
         f(0)
+    }
+    #[inline(always)]
+    fn width() -> usize {
+        1
     }
 }
 
@@ -71,6 +94,12 @@ pub trait Real:
     /// Lane `i` as f64.
     fn lane(self, i: usize) -> f64;
     fn from_fn(f: impl FnMut(usize) -> f64) -> Self;
+    /// Sets lane `i` to `v` (rounded to the lane's precision).
+    #[inline(always)]
+    fn set_lane(&mut self, i: usize, v: f64) {
+        let old = *self;
+        *self = Self::from_fn(|j| if j == i { v } else { old.lane(j) });
+    }
 
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
