@@ -216,7 +216,7 @@ fn sample_light(
     let u = u.1;
     let rng = sampler.rng();
     let light = &scene.lights[k];
-    let Some(ls) = light.sample(&scene.geometry, hit.p, hit.ng, u) else {
+    let Some(ls) = light.sample(&scene.geometry, hit.p, u) else {
         return Spectrum::ZERO;
     };
     if ls.radiance.is_black() {
@@ -231,7 +231,10 @@ fn sample_light(
     if f.is_black() {
         return Spectrum::ZERO;
     }
-    if scene.geometry.occluded_ray(&ls.shadow) {
+    if scene
+        .geometry
+        .occluded_ray(&ls.shadow.ray::<f64>(hit.p, hit.ng))
+    {
         return Spectrum::ZERO;
     }
     let pl = p_select * ls.pdf;

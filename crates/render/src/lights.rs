@@ -4,7 +4,8 @@
 //! sampled by the solid angle its shape subtends from the shading point
 //! ([`solid_angle_sampling`](crate::geometry::solid_angle_sampling)).
 
-use crate::geometry::{Ray, SceneGeometry, Vec2, Vec3};
+use crate::geometry::ray::ShadowEnd;
+use crate::geometry::{SceneGeometry, Vec2, Vec3};
 use crate::image::{ConstantEnvironment, EnvironmentMap};
 use facette_bsdf::math::Frame;
 use facette_bsdf::Spectrum;
@@ -101,8 +102,8 @@ pub struct LightSample {
     /// Solid-angle pdf of `wi` (1 for delta lights).
     pub pdf: f64,
     pub delta: bool,
-    /// The shadow ray to test (from the shading point to the light).
-    pub shadow: Ray,
+    /// Where the shadow ray from the shading point ends ([`ShadowEnd::ray`] makes it).
+    pub shadow: ShadowEnd,
 }
 
 impl Light {
@@ -161,15 +162,9 @@ impl Light {
         .max(0.0)
     }
 
-    /// Samples the light from the shading point `p` (geometric normal `ng`, used to offset
-    /// the shadow ray). `scene_radius` bounds the scene for distant lights.
-    pub fn sample(
-        &self,
-        geometry: &SceneGeometry,
-        p: Vec3,
-        ng: Vec3,
-        u: Vec2,
-    ) -> Option<LightSample> {
+    /// Samples the light from the shading point `p`; the shadow ray is made from the
+    /// sample's [`ShadowEnd`] with the point's geometric normal.
+    pub fn sample(&self, geometry: &SceneGeometry, p: Vec3, u: Vec2) -> Option<LightSample> {
         match self {
             Light::Point {
                 position,
@@ -185,7 +180,7 @@ impl Light {
                     radiance: *intensity / dist2,
                     pdf: 1.0,
                     delta: true,
-                    shadow: Ray::spawn_to(p, ng, *position),
+                    shadow: ShadowEnd::Point(*position),
                 })
             }
             Light::Spot {
@@ -210,7 +205,7 @@ impl Light {
                     radiance: *intensity * (f / dist2),
                     pdf: 1.0,
                     delta: true,
-                    shadow: Ray::spawn_to(p, ng, *position),
+                    shadow: ShadowEnd::Point(*position),
                 })
             }
             Light::Directional {
@@ -223,7 +218,7 @@ impl Light {
                     radiance: *irradiance,
                     pdf: 1.0,
                     delta: true,
-                    shadow: Ray::spawn(p, ng, wi),
+                    shadow: ShadowEnd::Away(wi),
                 })
             }
             Light::Area {
@@ -251,7 +246,7 @@ impl Light {
                     radiance: *radiance,
                     pdf: s.pdf,
                     delta: false,
-                    shadow: Ray::spawn_between(p, ng, q, nq),
+                    shadow: ShadowEnd::Surface { q, nq },
                 })
             }
             Light::Environment(e) => {
@@ -264,7 +259,7 @@ impl Light {
                     radiance,
                     pdf,
                     delta: false,
-                    shadow: Ray::spawn(p, ng, wi),
+                    shadow: ShadowEnd::Away(wi),
                 })
             }
         }

@@ -18,12 +18,35 @@
 //! is still far below any distance a render can show (a nanometre on a one-metre scene).
 //! Intersection routines accept only `t > 0`, so the offset is the only guard — there is
 //! no `t_min` to tune.
+//!
+//! The render kernel's f32 lanes (their rays, hit points and normals are f32) take
+//! [`RAY_EPSILON_F32`] = 2⁻¹⁷ ≈ 7.6e-6 in place of 2⁻³⁰: 128 ulps of a unit coordinate,
+//! about Mitsuba 3's single-precision `RayEpsilon` (89 ulps). The errors it must cover are
+//! a few ulps of `max |pᵢ|`: the sphere record's re-projection, a triangle hit computed in
+//! f64 and rounded to f32, and the next ray test's rounding of `|o − c|² − r²` (whose true
+//! value is `2rδ` for an origin `δ` off a sphere of radius `r`). The tests spawn rays off
+//! spheres far from the origin and off large meshes in f32 lanes and find no
+//! self-intersection.
 
 use super::Vec3;
 use facette_bsdf::lanes::{LVec3, Real};
 
 /// Relative offset of spawned ray origins; see the module documentation.
 pub const RAY_EPSILON: f64 = 1.0 / (1u64 << 30) as f64;
+
+/// Relative offset of spawned ray origins in f32 lanes; see the module documentation.
+pub const RAY_EPSILON_F32: f64 = 1.0 / (1u64 << 17) as f64;
+
+/// The relative offset for rays in lanes of `R`: [`RAY_EPSILON`] at f64 precision,
+/// [`RAY_EPSILON_F32`] below it.
+#[inline(always)]
+pub fn ray_epsilon<R: Real>() -> f64 {
+    if R::DIGITS >= f64::MANTISSA_DIGITS {
+        RAY_EPSILON
+    } else {
+        RAY_EPSILON_F32
+    }
+}
 
 /// A ray `origin + t·dir`, `0 < t ≤ t_max`. `dir` is a unit vector, so `t` is a distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,14 +84,13 @@ impl Ray {
     /// direction `dir`, its origin offset by the spawning rule.
     #[inline]
     pub fn spawn(p: Vec3, ng: Vec3, dir: Vec3) -> Ray {
-        Ray::new(offset_origin(p, ng, dir), dir, f64::INFINITY)
+        ShadowEnd::Away(dir).ray::<f64>(p, ng)
     }
 
     /// A ray from the surface point `p` (geometric normal `ng`) towards the point `target`
     /// (a point light, say), with `t_max` the distance to `target`.
     pub fn spawn_to(p: Vec3, ng: Vec3, target: Vec3) -> Ray {
-        let origin = offset_origin(p, ng, target - p);
-        segment(origin, target)
+        ShadowEnd::Point(target).ray::<f64>(p, ng)
     }
 
     /// A ray between two surface points — a shadow ray to a point sampled on an area
@@ -76,9 +98,7 @@ impl Ray {
     /// other end), so that neither surface occludes the segment (pbrt-v4's `SpawnRayTo`
     /// between two interactions).
     pub fn spawn_between(p: Vec3, ng: Vec3, q: Vec3, nq: Vec3) -> Ray {
-        let origin = offset_origin(p, ng, q - p);
-        let target = offset_origin(q, nq, p - q);
-        segment(origin, target)
+        ShadowEnd::Surface { q, nq }.ray::<f64>(p, ng)
     }
 }
 
@@ -106,16 +126,57 @@ fn segment(origin: Vec3, target: Vec3) -> Ray {
 /// normal `ng` to the side `dir` points to, by `(1 + max|pᵢ|) · RAY_EPSILON`.
 #[inline]
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    offset_origin_lanes::<f64>(p.into(), ng.into(), dir.into()).into()
+    offset_origin_by::<f64>(p.into(), ng.into(), dir.into(), RAY_EPSILON).into()
 }
 
-/// [`offset_origin`] over lanes, its one source.
+/// [`offset_origin`] over lanes, with the offset of the lanes' precision
+/// ([`ray_epsilon`]).
 #[inline(always)]
 pub fn offset_origin_lanes<R: Real>(p: LVec3<R>, ng: LVec3<R>, dir: LVec3<R>) -> LVec3<R> {
+    offset_origin_by(p, ng, dir, ray_epsilon::<R>())
+}
+
+/// The one source of the spawning rule: `p` moved along `ng` to the side `dir` points to,
+/// by `(1 + max|pᵢ|) · epsilon`.
+#[inline(always)]
+fn offset_origin_by<R: Real>(p: LVec3<R>, ng: LVec3<R>, dir: LVec3<R>, epsilon: f64) -> LVec3<R> {
     let largest = p.x.abs().max(p.y.abs().max(p.z.abs()));
-    let mag = (R::one() + largest) * R::splat(RAY_EPSILON);
+    let mag = (R::one() + largest) * R::splat(epsilon);
     let signed = R::select(ng.dot(dir).ge(R::zero()), mag, -mag);
     p + ng.scale(signed)
+}
+
+/// Where a light sample's shadow ray ends; the ray itself is made by
+/// [`ray`](Self::ray) with the offset of the precision it is traced at (the scalar
+/// integrator's f64, the render kernel's f32 lanes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowEnd {
+    /// Nowhere: the ray is unbounded along a unit direction (a distant light, the
+    /// environment).
+    Away(Vec3),
+    /// At a point (a point or spot light).
+    Point(Vec3),
+    /// At the point `q` of a surface of geometric normal `nq` (an area light), which is
+    /// offset towards the shading point too ([`Ray::spawn_between`]).
+    Surface { q: Vec3, nq: Vec3 },
+}
+
+impl ShadowEnd {
+    /// The shadow ray from the surface point `p` (geometric normal `ng`), offset by the
+    /// spawning rule of lanes `R` ([`ray_epsilon`]): `ray::<f64>` is what [`Ray::spawn`],
+    /// [`Ray::spawn_to`] and [`Ray::spawn_between`] give.
+    #[inline]
+    pub fn ray<R: Real>(&self, p: Vec3, ng: Vec3) -> Ray {
+        let eps = ray_epsilon::<R>();
+        let offset = |p: Vec3, n: Vec3, d: Vec3| -> Vec3 {
+            offset_origin_by::<f64>(p.into(), n.into(), d.into(), eps).into()
+        };
+        match *self {
+            ShadowEnd::Away(dir) => Ray::new(offset(p, ng, dir), dir, f64::INFINITY),
+            ShadowEnd::Point(target) => segment(offset(p, ng, target - p), target),
+            ShadowEnd::Surface { q, nq } => segment(offset(p, ng, q - p), offset(q, nq, p - q)),
+        }
+    }
 }
 
 /// The two auxiliary rays of a camera ray, offset by one pixel in x and in y (pbrt's

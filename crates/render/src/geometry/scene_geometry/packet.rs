@@ -13,7 +13,7 @@ use crate::geometry::shape::Shape;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::TriangleRay;
 use crate::geometry::{Vec2, Vec3};
-use facette_bsdf::lanes::{F64x8, LVec3, M64x8, Real};
+use facette_bsdf::lanes::{F64x8, LVec3, Mask, Real};
 
 /// A packet lane's closest hit: the primitive's slot in the BVH order and the hit.
 #[derive(Clone, Copy, Debug, Default)]
@@ -30,45 +30,46 @@ impl PacketHit {
     }
 }
 
-/// Eight rays in lanes (structure of arrays): f64 origins and directions per axis, their
+/// Eight rays in lanes of `R` (structure of arrays): origins and directions per axis, their
 /// limits, and the lanes that hold a ray. The render kernel keeps its paths' rays in this
-/// form; lanes without a valid ray hold a harmless one.
+/// form (`F32x8` in renders, `F64x8` in the test that finds the scalar integrator's image);
+/// lanes without a valid ray hold a harmless one.
 #[derive(Clone, Copy, Debug)]
-pub struct LaneRays {
-    pub o: LVec3<F64x8>,
-    pub d: LVec3<F64x8>,
-    pub t_max: F64x8,
+pub struct LaneRays<R: Real = F64x8> {
+    pub o: LVec3<R>,
+    pub d: LVec3<R>,
+    pub t_max: R,
     /// The lanes with a valid ray (finite origin, finite non-zero direction).
     pub lanes: Lanes,
 }
 
-impl LaneRays {
+impl<R: Real> LaneRays<R> {
     /// The rays of `lanes` from `o` along `d` up to `t_max`; a lane whose ray is not a
     /// valid query (a non-finite origin, a zero or non-finite direction) is dropped and
     /// given a harmless ray.
     #[inline(always)]
-    pub fn new(o: LVec3<F64x8>, d: LVec3<F64x8>, t_max: F64x8, lanes: Lanes) -> LaneRays {
+    pub fn new(o: LVec3<R>, d: LVec3<R>, t_max: R, lanes: Lanes) -> LaneRays<R> {
         let valid = o.x.is_finite()
             & o.y.is_finite()
             & o.z.is_finite()
             & d.x.is_finite()
             & d.y.is_finite()
             & d.z.is_finite()
-            & !(d.x.eq(F64x8::zero()) & d.y.eq(F64x8::zero()) & d.z.eq(F64x8::zero()));
-        let lanes = lanes & valid.bits() as Lanes;
-        let m = M64x8::from_bits(lanes as u32);
-        let unit = LVec3::new(F64x8::zero(), F64x8::zero(), F64x8::one());
+            & !(d.x.eq(R::zero()) & d.y.eq(R::zero()) & d.z.eq(R::zero()));
+        let lanes = lanes & valid.lane_bits() as Lanes;
+        let m = R::Mask::from_lane_bits(lanes as u32);
+        let unit = LVec3::new(R::zero(), R::zero(), R::one());
         LaneRays {
             o: LVec3::select(m, o, LVec3::zero()),
             d: LVec3::select(m, d, unit),
-            t_max: F64x8::select(m, t_max, F64x8::zero()),
+            t_max: R::select(m, t_max, R::zero()),
             lanes,
         }
     }
 
     /// The packet of `rays` (`None` lanes hold no ray).
     #[inline(always)]
-    pub fn from_rays(rays: &[Option<Ray>; PACKET]) -> LaneRays {
+    pub fn from_rays(rays: &[Option<Ray>; PACKET]) -> LaneRays<R> {
         let lanes = (0..PACKET).fold(0, |set, i| set | ((rays[i].is_some() as Lanes) << i));
         let ray = |i: usize| {
             rays[i].unwrap_or(Ray {
@@ -81,7 +82,7 @@ impl LaneRays {
         LaneRays::new(
             v(&|r| r.origin),
             v(&|r| r.dir),
-            F64x8::from_fn(|i| ray(i).t_max),
+            R::from_fn(|i| ray(i).t_max),
             lanes,
         )
     }
@@ -92,26 +93,21 @@ impl LaneRays {
         Ray {
             origin: self.o.lane(i),
             dir: self.d.lane(i),
-            t_max: self.t_max.0[i],
+            t_max: self.t_max.lane(i),
         }
     }
 
-    /// The coordinates as arrays per axis (the traversal's set-up reads them so).
+    /// The coordinates as f64 arrays per axis (the traversal's set-up reads them so).
     #[inline(always)]
-    fn axes(v: &LVec3<F64x8>) -> [[f64; PACKET]; 3] {
-        [v.x.0, v.y.0, v.z.0]
+    fn axes(v: &LVec3<R>) -> [[f64; PACKET]; 3] {
+        [v.x, v.y, v.z].map(|c| std::array::from_fn(|i| c.lane(i)))
     }
 
-    /// The lanes of `lanes` whose ray hits `sphere` in `(0, t_max[i]]`, with the distance.
+    /// The lanes of `lanes` whose ray hits `sphere` in `(0, t_max]`, with the distance.
     #[inline(always)]
-    fn sphere(
-        &self,
-        sphere: &Sphere,
-        lanes: Lanes,
-        t_max: &[f64; PACKET],
-    ) -> (Lanes, [f64; PACKET]) {
-        let (m, t) = sphere.intersect_lanes(self.o, self.d, F64x8(*t_max));
-        (m.bits() as Lanes & lanes, t.0)
+    fn sphere(&self, sphere: &Sphere, lanes: Lanes, t_max: R) -> (Lanes, R) {
+        let (m, t) = sphere.intersect_lanes(self.o, self.d, t_max);
+        (m.lane_bits() as Lanes & lanes, t)
     }
 }
 
@@ -121,13 +117,13 @@ impl LaneRays {
 /// record ([`Sphere::shading_hit_lanes`]; their `dpdv` and `uv` are left at zero until
 /// [`complete_hit`](SceneGeometry::complete_hit)), the other shapes lane by lane.
 #[derive(Clone, Copy, Debug)]
-pub struct HitLanes {
-    pub t: F64x8,
-    pub p: LVec3<F64x8>,
-    pub ng: LVec3<F64x8>,
-    pub ns: LVec3<F64x8>,
-    pub dpdu: LVec3<F64x8>,
-    pub dpdv: LVec3<F64x8>,
+pub struct HitLanes<R: Real = F64x8> {
+    pub t: R,
+    pub p: LVec3<R>,
+    pub ng: LVec3<R>,
+    pub ns: LVec3<R>,
+    pub dpdu: LVec3<R>,
+    pub dpdv: LVec3<R>,
     pub uv: [[f64; PACKET]; 2],
     pub shape: [u32; PACKET],
     pub prim: [u32; PACKET],
@@ -135,12 +131,12 @@ pub struct HitLanes {
     pub lanes: Lanes,
 }
 
-impl Default for HitLanes {
+impl<R: Real> Default for HitLanes<R> {
     /// No lane, every field zero.
     fn default() -> Self {
         let zero = LVec3::zero();
         HitLanes {
-            t: F64x8::zero(),
+            t: R::zero(),
             p: zero,
             ng: zero,
             ns: zero,
@@ -154,12 +150,12 @@ impl Default for HitLanes {
     }
 }
 
-impl HitLanes {
+impl<R: Real> HitLanes<R> {
     /// Lane `i`'s record.
     #[inline]
     pub fn surface_hit(&self, i: usize) -> SurfaceHit {
         SurfaceHit {
-            t: self.t.0[i],
+            t: self.t.lane(i),
             p: self.p.lane(i),
             ng: self.ng.lane(i),
             ns: self.ns.lane(i),
@@ -174,12 +170,12 @@ impl HitLanes {
     /// Stores `h` in lane `i`.
     #[inline]
     fn set(&mut self, i: usize, h: &SurfaceHit) {
-        let put = |v: &mut LVec3<F64x8>, w: Vec3| {
-            v.x.0[i] = w.x;
-            v.y.0[i] = w.y;
-            v.z.0[i] = w.z;
+        let put = |v: &mut LVec3<R>, w: Vec3| {
+            v.x.set_lane(i, w.x);
+            v.y.set_lane(i, w.y);
+            v.z.set_lane(i, w.z);
         };
-        self.t.0[i] = h.t;
+        self.t.set_lane(i, h.t);
         put(&mut self.p, h.p);
         put(&mut self.ng, h.ng);
         put(&mut self.ns, h.ns);
@@ -194,12 +190,14 @@ impl HitLanes {
 
 /// A closest-hit query in progress: the hit of each lane so far. Its primitive test is a
 /// method forced inline so that it is compiled into the kernel's AVX2 instantiation.
-struct Closest<'a> {
+struct Closest<'a, R: Real> {
     geometry: &'a SceneGeometry,
-    rays: &'a LaneRays,
+    rays: &'a LaneRays<R>,
     /// The caller's result, written in place for the lanes that hit (a by-value array
     /// here was copied out with `memcpy` at every query).
     best: &'a mut [PacketHit; PACKET],
+    /// Each lane's distance limit: the ray's, then its closest hit's.
+    t: R,
     /// The lanes with a hit so far.
     found: Lanes,
     tri: TriangleRays,
@@ -219,33 +217,36 @@ impl TriangleRays {
     }
 }
 
-impl Closest<'_> {
-    /// Tests the primitive in `slot` for `lanes` within `(0, t_max[i]]`; lowers `t_max`
-    /// where it hits and returns those lanes.
+impl<R: Real> Closest<'_, R> {
+    /// Tests the primitive in `slot` for `lanes` within `(0, t]`; lowers `t` where it
+    /// hits and returns those lanes.
     #[inline(always)]
-    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]) -> Lanes {
+    fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
         let g = self.geometry;
         if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
-            let (hit, t) = self.rays.sphere(s, lanes, t_max);
-            for i in lanes_of(hit) {
-                t_max[i] = t[i];
-                self.best[i] = PacketHit {
-                    slot: slot as u32,
-                    hit: PrimHit {
-                        t: t[i],
-                        local: Vec2::ZERO,
-                    },
-                };
+            let (hit, t) = self.rays.sphere(s, lanes, self.t);
+            if hit != 0 {
+                self.t = R::select(R::Mask::from_lane_bits(hit as u32), t, self.t);
+                for i in lanes_of(hit) {
+                    self.best[i] = PacketHit {
+                        slot: slot as u32,
+                        hit: PrimHit {
+                            t: t.lane(i),
+                            local: Vec2::ZERO,
+                        },
+                    };
+                }
+                self.found |= hit;
             }
-            self.found |= hit;
             return hit;
         }
         let mut found = 0;
         for i in lanes_of(lanes) {
             let ray = self.rays.ray(i);
-            if let Some(h) = g.test_prim(slot, &ray, self.tri.lane(i), t_max[i]) {
-                if h.t <= t_max[i] {
-                    t_max[i] = h.t;
+            let t_max = self.t.lane(i);
+            if let Some(h) = g.test_prim(slot, &ray, self.tri.lane(i), t_max) {
+                if h.t <= t_max {
+                    self.t.set_lane(i, h.t);
                     self.best[i] = PacketHit {
                         slot: slot as u32,
                         hit: h,
@@ -260,24 +261,24 @@ impl Closest<'_> {
 }
 
 /// An occlusion query in progress (see [`Closest`]).
-struct Occluded<'a> {
+struct Occluded<'a, R: Real> {
     geometry: &'a SceneGeometry,
-    rays: &'a LaneRays,
+    rays: &'a LaneRays<R>,
     tri: TriangleRays,
 }
 
-impl Occluded<'_> {
-    /// The lanes of `lanes` whose ray hits the primitive in `slot` within `t_max`.
+impl<R: Real> Occluded<'_, R> {
+    /// The lanes of `lanes` whose ray hits the primitive in `slot` within its limit.
     #[inline(always)]
-    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &[f64; PACKET]) -> Lanes {
+    fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
         let g = self.geometry;
         if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
-            return self.rays.sphere(s, lanes, t_max).0;
+            return self.rays.sphere(s, lanes, self.rays.t_max).0;
         }
         lanes_of(lanes).fold(0, |hit, i| {
             let ray = self.rays.ray(i);
             let occluded = g
-                .test_prim(slot, &ray, self.tri.lane(i), t_max[i])
+                .test_prim(slot, &ray, self.tri.lane(i), ray.t_max)
                 .is_some();
             hit | ((occluded as Lanes) << i)
         })
@@ -307,37 +308,44 @@ impl SceneGeometry {
     #[inline(always)]
     pub fn intersect_packet(&self, rays: &[Option<Ray>; PACKET]) -> [Option<PacketHit>; PACKET] {
         let mut hits = [PacketHit::default(); PACKET];
-        let found = self.intersect_lanes(&LaneRays::from_rays(rays), &mut hits);
+        let (found, _) = self.intersect_lanes(&LaneRays::<F64x8>::from_rays(rays), &mut hits);
         std::array::from_fn(|i| (found & (1 << i) != 0).then_some(hits[i]))
     }
 
     /// [`intersect_packet`](Self::intersect_packet) for rays already in lanes: the lanes
-    /// with a hit, whose hits are written to `hits` (the other lanes of `hits` are left as
-    /// they were: the caller keeps one buffer across queries, nothing is copied out).
+    /// with a hit and their distances in lanes, the hits written to `hits` (the other
+    /// lanes of `hits` are left as they were: the caller keeps one buffer across queries,
+    /// nothing is copied out).
     #[inline(always)]
-    pub fn intersect_lanes(&self, rays: &LaneRays, hits: &mut [PacketHit; PACKET]) -> Lanes {
+    pub fn intersect_lanes<R: Real>(
+        &self,
+        rays: &LaneRays<R>,
+        hits: &mut [PacketHit; PACKET],
+    ) -> (Lanes, R) {
         let lanes = rays.lanes;
         if lanes == 0 {
-            return 0;
+            return (0, rays.t_max);
         }
         if !self.packet_traversal() {
             let mut found = 0;
+            let mut t = rays.t_max;
             for i in lanes_of(lanes) {
                 if let Some((slot, hit)) = self.closest_slot(&rays.ray(i)) {
                     hits[i] = PacketHit {
                         slot: slot as u32,
                         hit,
                     };
+                    t.set_lane(i, hit.t);
                     found |= 1 << i;
                 }
             }
-            return found;
+            return (found, t);
         }
-        let mut t_max = rays.t_max.0;
         let mut q = Closest {
             geometry: self,
             rays,
             best: hits,
+            t: rays.t_max,
             found: 0,
             tri: TriangleRays::default(),
         };
@@ -345,18 +353,23 @@ impl SceneGeometry {
             // A scene of a few primitives: no box to test.
             Some(slots) => {
                 for slot in slots {
-                    q.test(slot, lanes, &mut t_max);
+                    q.test(slot, lanes);
                 }
             }
             None => {
                 let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
+                let mut t_max = std::array::from_fn(|i| rays.t_max.lane(i));
                 self.bvh
                     .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
-                        q.test(slot, lanes, t_max)
+                        let hit = q.test(slot, lanes);
+                        for i in lanes_of(hit) {
+                            t_max[i] = q.t.lane(i);
+                        }
+                        hit
                     });
             }
         }
-        q.found
+        (q.found, q.t)
     }
 
     /// The surface record of `ray`'s hit `hit` found by
@@ -367,19 +380,20 @@ impl SceneGeometry {
         self.hit_record(hit.slot as usize, ray, hit.hit, detail)
     }
 
-    /// The surface records of the hits `hits` of `rays` in the lanes `found` (as
-    /// [`intersect_lanes`](Self::intersect_lanes) gives them), written into `out`: spheres
+    /// The surface records of the hits `hits` of `rays` in the lanes `found` at the
+    /// distances `t` (as [`intersect_lanes`](Self::intersect_lanes) gives them), written
+    /// into `out`: spheres
     /// hit by several lanes eight lanes at a time, every other hit lane by lane. Only the
     /// lanes of `found` are written (and `out.lanes` set to them): the caller keeps one
     /// record across segments, neither cleared nor copied out (a `memset` and a `memcpy`
     /// of its 1.1 KB per segment before).
     #[inline(always)]
-    pub fn hit_lanes(
+    pub fn hit_lanes<R: Real>(
         &self,
-        rays: &LaneRays,
+        rays: &LaneRays<R>,
         hits: &[PacketHit; PACKET],
-        found: Lanes,
-        out: &mut HitLanes,
+        (found, t): (Lanes, R),
+        out: &mut HitLanes<R>,
     ) {
         out.lanes = found;
         if found == 0 {
@@ -400,11 +414,10 @@ impl SceneGeometry {
             todo &= !group;
             match &self.shapes[shape as usize] {
                 Shape::Sphere(sphere) if group.count_ones() > 1 => {
-                    let t = F64x8::from_fn(|i| hits[i].hit.t);
                     let (p, n, dpdu, _) = sphere.shading_hit_lanes(rays.o, rays.d, t);
-                    let m = M64x8::from_bits(group as u32);
+                    let m = R::Mask::from_lane_bits(group as u32);
                     let zero = LVec3::zero();
-                    out.t = F64x8::select(m, t, out.t);
+                    out.t = R::select(m, t, out.t);
                     out.p = LVec3::select(m, p, out.p);
                     out.ng = LVec3::select(m, n, out.ng);
                     out.ns = LVec3::select(m, n, out.ns);
@@ -438,12 +451,12 @@ impl SceneGeometry {
     /// (`None` lanes are not).
     #[inline(always)]
     pub fn occluded_packet(&self, rays: &[Option<Ray>; PACKET]) -> Lanes {
-        self.occluded_lanes(&LaneRays::from_rays(rays))
+        self.occluded_lanes(&LaneRays::<F64x8>::from_rays(rays))
     }
 
     /// [`occluded_packet`](Self::occluded_packet) for rays already in lanes.
     #[inline(always)]
-    pub fn occluded_lanes(&self, rays: &LaneRays) -> Lanes {
+    pub fn occluded_lanes<R: Real>(&self, rays: &LaneRays<R>) -> Lanes {
         let lanes = rays.lanes;
         if lanes == 0 {
             return 0;
@@ -453,13 +466,12 @@ impl SceneGeometry {
                 set | ((self.occluded_ray(&rays.ray(i)) as Lanes) << i)
             });
         }
-        let t_max = rays.t_max.0;
         let mut q = Occluded {
             geometry: self,
             rays,
             tri: TriangleRays::default(),
         };
-        let mut test = |slot, lanes| q.test(slot, lanes, &t_max);
+        let mut test = |slot, lanes| q.test(slot, lanes);
         match self.bvh.single_leaf() {
             Some(slots) => {
                 let mut left = lanes;
@@ -473,6 +485,7 @@ impl SceneGeometry {
             }
             None => {
                 let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
+                let t_max = std::array::from_fn(|i| rays.t_max.lane(i));
                 self.bvh.any_hit_packet(&pb, lanes, &t_max, test)
             }
         }
@@ -587,6 +600,138 @@ mod tests {
             hits > 1000 && occluded > 1000,
             "{hits} hits, {occluded} occluded"
         );
+    }
+
+    /// Rays spawned in f32 lanes (the render kernel's) off spheres and meshes far from the
+    /// origin, and off a tiny sphere near it, in random directions, never hit the
+    /// primitive they leave (outwards) and never leak out of a sphere (inwards: they hit
+    /// its far side, at the chord's length). The same in f64 lanes.
+    #[test]
+    fn rays_spawned_in_lanes_do_not_hit_their_own_surface() {
+        use crate::geometry::ray::offset_origin_lanes;
+        use facette_bsdf::lanes::F32x8;
+        let spheres = [
+            (Vec3::new(1e3, -2e3, 5e2), 1.0),
+            (Vec3::new(3e4, 1e4, -2e4), 50.0),
+            (Vec3::new(-0.3, 0.2, 0.1), 1e-3),
+        ];
+        let mut shapes: Vec<Shape> = spheres
+            .iter()
+            .map(|&(c, r)| Sphere::new(c, r).unwrap().into())
+            .collect();
+        let knot_at = Vec3::new(-5e3, 2e3, 1e3);
+        let knot = TorusKnot::with_triangles(100_000)
+            .mesh(
+                &(Transform::translate(knot_at).unwrap()
+                    * Transform::scale(Vec3::splat(40.0)).unwrap()),
+            )
+            .unwrap();
+        shapes.push(knot.into());
+        let floor_at = Vec3::new(2e3, 3e3, -1e3);
+        let floor = Rectangle::new(
+            &(Transform::translate(floor_at).unwrap()
+                * Transform::rotate(Vec3::new(1.0, 2.0, 0.5), 33.0).unwrap()
+                * Transform::scale(Vec3::new(400.0, 300.0, 1.0)).unwrap()),
+            false,
+        )
+        .unwrap();
+        shapes.push(floor.into());
+        let mut geometry = SceneGeometry::new(shapes).unwrap();
+        // Aim points and sizes: the spheres, the knot (about 3 × 40 across), the floor.
+        let mut targets: Vec<(Vec3, f64)> = spheres.to_vec();
+        targets.push((knot_at, 60.0));
+        targets.push((floor_at, 250.0));
+        for packet_traversal in [false, true] {
+            geometry.packet_traversal = packet_traversal;
+            let f32_counts = spawn_off_surfaces::<F32x8>(&geometry, &targets, spheres.len());
+            let f64_counts = spawn_off_surfaces::<F64x8>(&geometry, &targets, spheres.len());
+            for (out, inward, mesh) in [f32_counts, f64_counts] {
+                // Enough of each kind for the check to mean something.
+                assert!(
+                    out > 3000 && inward > 1000 && mesh > 1000,
+                    "{out} outward, {inward} inward, {mesh} off the knot and floor"
+                );
+            }
+        }
+
+        /// Spawns rays off first hits; panics at a self-hit or a leak; returns the counts
+        /// of outward and inward sphere rays and of mesh and floor rays checked.
+        fn spawn_off_surfaces<R: Real>(
+            geometry: &SceneGeometry,
+            targets: &[(Vec3, f64)],
+            sphere_count: usize,
+        ) -> (usize, usize, usize) {
+            let mut rng = Pcg32::new(11, 3);
+            let (mut out, mut inward, mut mesh) = (0, 0, 0);
+            let mut hits = [PacketHit::default(); PACKET];
+            let mut record = HitLanes::<R>::default();
+            for n in 0..2000 {
+                let (center, size) = targets[n % targets.len()];
+                let mut u = || Vec2::new(rng.next_f64(), rng.next_f64());
+                let from: [Vec3; PACKET] =
+                    std::array::from_fn(|_| center + square_to_uniform_sphere(u()) * (4.0 * size));
+                let to: [Vec3; PACKET] = std::array::from_fn(|_| {
+                    center + square_to_uniform_sphere(u()) * (0.7 * size * u().x)
+                });
+                let o = LVec3::from_fn(|i| from[i]);
+                let d = LVec3::from_fn(|i| (to[i] - from[i]).normalize());
+                let rays = LaneRays::new(o, d, R::splat(f64::INFINITY), 0xff);
+                let found = geometry.intersect_lanes(&rays, &mut hits);
+                geometry.hit_lanes(&rays, &hits, found, &mut record);
+                let dirs: [Vec3; PACKET] = std::array::from_fn(|_| square_to_uniform_sphere(u()));
+                let dir = LVec3::from_fn(|i| dirs[i]);
+                let spawned = LaneRays::new(
+                    offset_origin_lanes(record.p, record.ng, dir),
+                    dir,
+                    R::splat(f64::INFINITY),
+                    found.0,
+                );
+                let mut again = [PacketHit::default(); PACKET];
+                let (hit, t) = geometry.intersect_lanes(&spawned, &mut again);
+                let blocked = geometry.occluded_lanes(&spawned);
+                assert_eq!(blocked, hit, "the occlusion query disagrees");
+                for i in lanes_of(spawned.lanes) {
+                    let (shape, prim) = (record.shape[i], record.prim[i]);
+                    let outward = dirs[i].dot(record.ng.lane(i)) > 0.0;
+                    let again = (hit & (1 << i) != 0).then(|| {
+                        let h = geometry.packet_hit_record(
+                            &spawned.ray(i),
+                            again[i],
+                            HitDetail::Shading,
+                        );
+                        (h.shape, h.prim, t.lane(i))
+                    });
+                    let same = again.filter(|&(s, p, _)| (s, p) == (shape, prim));
+                    if (shape as usize) < sphere_count {
+                        let (c, r) = targets[shape as usize];
+                        if outward {
+                            assert!(same.is_none(), "self-hit off sphere {shape}: {same:?}");
+                            out += 1;
+                        } else {
+                            // It leaves the sphere: its hit is on the surface (to a few
+                            // ulps of the coordinates), on the far side (moving outwards).
+                            let Some((_, _, t)) = same else {
+                                panic!("leak out of sphere {shape}: {again:?}")
+                            };
+                            let ray = spawned.ray(i);
+                            let q = ray.origin + ray.dir * t;
+                            let scale = 1.0 + ray.origin.abs().max_element();
+                            let off = ((q - c).length() - r).abs();
+                            assert!(
+                                off <= 1e-5 * scale && (q - c).dot(ray.dir) > 0.0,
+                                "sphere {shape} ({} bits): exit {q:?} off the surface by {off}",
+                                R::DIGITS
+                            );
+                            inward += 1;
+                        }
+                    } else {
+                        assert!(same.is_none(), "self-hit off shape {shape} prim {prim}");
+                        mesh += 1;
+                    }
+                }
+            }
+            (out, inward, mesh)
+        }
     }
 
     /// The lanes that hit something and the occluded lanes.
