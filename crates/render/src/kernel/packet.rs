@@ -1337,6 +1337,29 @@ mod tests {
         radiance = 0.5
     "#;
 
+    /// The whole frame of `scene` as one tile, without footprints.
+    fn whole_frame<'a>(
+        scene: &'a Scene,
+        sampler: &'a PixelSampler,
+        strategy: Strategy,
+        chunk: &'a [u32],
+        stop: &'a dyn Fn() -> bool,
+    ) -> TileJob<'a> {
+        TileJob {
+            scene,
+            sampler,
+            cameras: CameraSampling {
+                footprints: false,
+                diff_scale: 1.0,
+            },
+            strategy,
+            xs: 0..scene.film.width,
+            ys: 0..scene.film.height,
+            chunk,
+            stop,
+        }
+    }
+
     /// With f64 shading lanes the packet kernel is the scalar integrator in another order:
     /// every pixel agrees to 1e-9 for every sampler and estimator (the lane models differ
     /// from the f64 models only in how they write the sampling weight and the dielectric's
@@ -1367,16 +1390,7 @@ mod tests {
         ] {
             for strategy in [Strategy::Mis, Strategy::NeeOnly, Strategy::BsdfOnly] {
                 let sampler = PixelSampler::new(kind, 4, w, h, 8);
-                let job = TileJob {
-                    scene: &scene,
-                    sampler: &sampler,
-                    cameras,
-                    strategy,
-                    xs: 0..w,
-                    ys: 0..h,
-                    chunk: &chunk,
-                    stop: &never,
-                };
+                let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let mut lanes = Vec::new();
                 assert_eq!(render_tile_lanes::<F64x8, F64x8>(&job, &mut lanes), h);
                 let mut f32_lanes = Vec::new();
@@ -1416,25 +1430,12 @@ mod tests {
     fn f32_geometry_renders_the_image_of_f64_geometry() {
         let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
         let (w, h) = (scene.film.width, scene.film.height);
-        let cameras = CameraSampling {
-            footprints: false,
-            diff_scale: 1.0,
-        };
         let chunk: Vec<u32> = (0..16).collect();
         let never = || false;
         for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
             for strategy in [Strategy::Mis, Strategy::NeeOnly, Strategy::BsdfOnly] {
                 let sampler = PixelSampler::new(kind, 9, w, h, 16);
-                let job = TileJob {
-                    scene: &scene,
-                    sampler: &sampler,
-                    cameras,
-                    strategy,
-                    xs: 0..w,
-                    ys: 0..h,
-                    chunk: &chunk,
-                    stop: &never,
-                };
+                let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let (mut f64_geometry, mut f32_geometry) = (Vec::new(), Vec::new());
                 render_tile_lanes::<F32x8, F64x8>(&job, &mut f64_geometry);
                 render_tile_lanes::<F32x8, F32x8>(&job, &mut f32_geometry);
