@@ -25,14 +25,7 @@ pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output
     /// One bit per lane, lane `i` in bit `i` (AVX's `movemask`).
     #[inline(always)]
     fn lane_bits(self) -> u32 {
-        let mut b = 0;
-        for i in 0..32 {
-            if i == Self::width() {
-                break;
-            }
-            b |= (self.lane(i) as u32) << i;
-        }
-        b
+        (0..Self::width()).fold(0, |b, i| b | ((self.lane(i) as u32) << i))
     }
     /// The mask with lane `i` set where bit `i` of `bits` is.
     #[inline(always)]

@@ -29,6 +29,13 @@ impl<R: Real> LVec3<R> {
     pub fn lane(self, i: usize) -> Vec3 {
         Vec3::new(self.x.lane(i), self.y.lane(i), self.z.lane(i))
     }
+    /// Sets lane `i` to `v` (each coordinate rounded to the lanes' precision).
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, v: Vec3) {
+        self.x.set_lane(i, v.x);
+        self.y.set_lane(i, v.y);
+        self.z.set_lane(i, v.z);
+    }
     #[inline(always)]
     pub fn from_fn(mut f: impl FnMut(usize) -> Vec3) -> Self {
         let v: [Vec3; 16] = std::array::from_fn(|i| if i < R::LANES { f(i) } else { Vec3::ZERO });

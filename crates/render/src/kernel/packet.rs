@@ -499,11 +499,8 @@ impl<'s> Kernel<'s> {
             paths.slot[i] = batch.slot[j];
             paths.streams.take(i, &mut batch.streams, j);
             paths.samples.copy_lane(i, &batch.samples, j);
-            for (p, b) in [(&mut paths.o, &batch.o), (&mut paths.d, &batch.d)] {
-                p.x.set_lane(i, b.x.lane(j));
-                p.y.set_lane(i, b.y.lane(j));
-                p.z.set_lane(i, b.z.lane(j));
-            }
+            paths.o.set_lane(i, batch.o.lane(j));
+            paths.d.set_lane(i, batch.d.lane(j));
             paths.rd[i] = batch.rd[j];
             filled |= 1 << i;
         }
@@ -582,11 +579,8 @@ impl<'s> Kernel<'s> {
             for i in 0..n {
                 let lens = crate::geometry::Vec2::new(lens.0.lane(i), lens.1.lane(i));
                 let (ray, rd) = scene.camera.generate_ray(fx.lane(i), fy.lane(i), lens);
-                for (v, w) in [(&mut batch.o, ray.origin), (&mut batch.d, ray.dir)] {
-                    v.x.set_lane(i, w.x);
-                    v.y.set_lane(i, w.y);
-                    v.z.set_lane(i, w.z);
-                }
+                batch.o.set_lane(i, ray.origin);
+                batch.d.set_lane(i, ray.dir);
                 batch.rd[i] = Some(rd.scaled(&ray, self.cameras.diff_scale));
             }
         } else {
@@ -963,14 +957,9 @@ impl<'s> Kernel<'s> {
                         }
                         // The shadow ray offset for the lanes' precision.
                         let shadow = ls.shadow.ray::<G>(p, hl.ng.lane(i));
-                        let put = |v: &mut LVec3<G>, w: Vec3| {
-                            v.x.set_lane(i, w.x);
-                            v.y.set_lane(i, w.y);
-                            v.z.set_lane(i, w.z);
-                        };
-                        put(&mut wi, ls.wi);
-                        put(&mut shadow_o, shadow.origin);
-                        put(&mut shadow_d, shadow.dir);
+                        wi.set_lane(i, ls.wi);
+                        shadow_o.set_lane(i, shadow.origin);
+                        shadow_d.set_lane(i, shadow.dir);
                         shadow_t.set_lane(i, shadow.t_max);
                         rgb_set(&mut le, i, ls.radiance);
                         pdf_light.set_lane(i, ls.pdf);
@@ -1152,9 +1141,7 @@ impl<'s> Kernel<'s> {
             let Some(s) = bsdf.sample(wo.lane(i), &ctx, &mut source) else {
                 continue;
             };
-            wi.x.set_lane(i, s.wi.x);
-            wi.y.set_lane(i, s.wi.y);
-            wi.z.set_lane(i, s.wi.z);
+            wi.set_lane(i, s.wi);
             rgb_set(&mut weight, i, s.weight);
             pdf.set_lane(i, s.pdf);
             eta.set_lane(i, s.eta);

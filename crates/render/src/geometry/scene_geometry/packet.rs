@@ -170,17 +170,12 @@ impl<R: Real> HitLanes<R> {
     /// Stores `h` in lane `i`.
     #[inline]
     fn set(&mut self, i: usize, h: &SurfaceHit) {
-        let put = |v: &mut LVec3<R>, w: Vec3| {
-            v.x.set_lane(i, w.x);
-            v.y.set_lane(i, w.y);
-            v.z.set_lane(i, w.z);
-        };
         self.t.set_lane(i, h.t);
-        put(&mut self.p, h.p);
-        put(&mut self.ng, h.ng);
-        put(&mut self.ns, h.ns);
-        put(&mut self.dpdu, h.dpdu);
-        put(&mut self.dpdv, h.dpdv);
+        self.p.set_lane(i, h.p);
+        self.ng.set_lane(i, h.ng);
+        self.ns.set_lane(i, h.ns);
+        self.dpdu.set_lane(i, h.dpdu);
+        self.dpdv.set_lane(i, h.dpdv);
         self.uv[0][i] = h.uv.x;
         self.uv[1][i] = h.uv.y;
         self.shape[i] = h.shape;
