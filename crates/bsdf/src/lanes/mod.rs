@@ -1,5 +1,5 @@
 //! One source, several widths: the [`Real`] lane trait and its instantiations (`f64` for the
-//! lab, `f32` and [`F32x8`] for the renderer's kernel, [`F64x4`] and [`F64x8`] for its
+//! lab, `f32`, [`F32x8`] and (on x86-64 with AVX2) `F32x8Avx2` for the renderer's kernel, [`F64x4`] and [`F64x8`] for its
 //! geometry), the integer lanes [`Bits32`] (`u32` and [`U32x8`], the samplers' hashing) and
 //! the lane vector [`LVec3`] — the bottom layer of the lane code, beside `math`. The models that
 //! vectorize are `models::lane_models`, over these lanes. The microfacet core
@@ -7,7 +7,11 @@
 //! the f64 [`Distribution`](crate::microfacet::Distribution) methods instantiate.
 
 pub(crate) mod array_lanes;
+#[cfg(target_arch = "x86_64")]
+pub mod avx2;
 mod cell_table;
+mod channels;
+pub mod f32_polynomials;
 mod f32x8;
 mod f64x4;
 mod f64x8;
@@ -16,7 +20,10 @@ mod real;
 mod u32x8;
 mod vec3;
 
+#[cfg(target_arch = "x86_64")]
+pub use avx2::{F32x8Avx2, M32x8Avx2, U32x8Avx2};
 pub use cell_table::CellTable;
+pub use channels::{channels, map_channels};
 pub use f32x8::{F32x8, M32x8};
 pub use f64x4::{F64x4, M64x4};
 pub use f64x8::{F64x8, M64x8};

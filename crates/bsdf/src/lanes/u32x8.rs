@@ -15,6 +15,7 @@ pub trait Bits32:
     fn lane(self, i: usize) -> u32;
     fn from_fn(f: impl FnMut(usize) -> u32) -> Self;
     fn wrapping_add(self, o: Self) -> Self;
+    fn wrapping_sub(self, o: Self) -> Self;
     fn wrapping_mul(self, o: Self) -> Self;
     /// `self << n` (n < 32).
     fn shl(self, n: u32) -> Self;
@@ -65,6 +66,10 @@ impl Bits32 for u32 {
     #[inline(always)]
     fn wrapping_add(self, o: Self) -> Self {
         u32::wrapping_add(self, o)
+    }
+    #[inline(always)]
+    fn wrapping_sub(self, o: Self) -> Self {
+        u32::wrapping_sub(self, o)
     }
     #[inline(always)]
     fn wrapping_mul(self, o: Self) -> Self {
@@ -123,6 +128,10 @@ impl Bits32 for U32x8 {
         U32x8(std::array::from_fn(|i| self.0[i].wrapping_add(o.0[i])))
     }
     #[inline(always)]
+    fn wrapping_sub(self, o: Self) -> Self {
+        U32x8(std::array::from_fn(|i| self.0[i].wrapping_sub(o.0[i])))
+    }
+    #[inline(always)]
     fn wrapping_mul(self, o: Self) -> Self {
         U32x8(std::array::from_fn(|i| self.0[i].wrapping_mul(o.0[i])))
     }
@@ -164,6 +173,7 @@ mod tests {
             assert_eq!(Bits32::reverse(x), x.reverse_bits());
             assert_eq!(a.wrapping_mul(b).0[i], x.wrapping_mul(y));
             assert_eq!(a.wrapping_add(b).0[i], x.wrapping_add(y));
+            assert_eq!(a.wrapping_sub(b).0[i], x.wrapping_sub(y));
             assert_eq!((a ^ b).0[i], x ^ y);
             assert_eq!(a.shl(3).0[i], x << 3);
             assert_eq!(a.shr(5).0[i], x >> 5);

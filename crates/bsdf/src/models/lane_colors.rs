@@ -8,7 +8,7 @@
 
 use super::il::interfaced_lambertian::{body_factor, specular_probability};
 use super::lane_models::LaneBsdf;
-use crate::lanes::Real;
+use crate::lanes::{channels, map_channels, Real};
 use crate::math::INV_PI;
 use crate::Spectrum;
 
@@ -31,8 +31,8 @@ impl<R: Real> LaneColors<R> {
     #[inline(always)]
     pub fn from_points<'a>(point: impl Fn(usize) -> &'a LaneColors<f64>) -> LaneColors<R> {
         LaneColors {
-            tint: std::array::from_fn(|c| R::from_fn(|i| point(i).tint[c])),
-            transmit_tint: std::array::from_fn(|c| R::from_fn(|i| point(i).transmit_tint[c])),
+            tint: channels(|c| R::from_fn(|i| point(i).tint[c])),
+            transmit_tint: channels(|c| R::from_fn(|i| point(i).transmit_tint[c])),
             specular_probability: R::from_fn(|i| point(i).specular_probability),
         }
     }
@@ -53,11 +53,11 @@ pub struct OwnColors;
 impl<R: Real> ColorSource<R> for OwnColors {
     #[inline(always)]
     fn tint(&self, own: &[f64; 3]) -> [R; 3] {
-        own.map(R::splat)
+        map_channels(*own, R::splat)
     }
     #[inline(always)]
     fn transmit_tint(&self, own: &[f64; 3]) -> [R; 3] {
-        own.map(R::splat)
+        map_channels(*own, R::splat)
     }
     #[inline(always)]
     fn specular_probability(&self, own: f64) -> R {

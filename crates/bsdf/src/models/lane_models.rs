@@ -25,7 +25,7 @@ use crate::bsdf::LobeFlags;
 use crate::fresnel::conductor::fresnel_conductor_lanes;
 use crate::fresnel::dielectric::fresnel_dielectric_lanes;
 use crate::fresnel::Fresnel;
-use crate::lanes::{LVec3, Mask, Real};
+use crate::lanes::{channels, map_channels, LVec3, Mask, Real};
 use crate::math::INV_PI;
 use crate::microfacet::{Beckmann, Ggx, Ndf};
 use crate::recipe::microfacet::with_roughness;
@@ -138,13 +138,19 @@ impl LaneFresnel {
         match self {
             LaneFresnel::One => [R::one(); 3],
             LaneFresnel::Conductor { eta, k } => {
-                std::array::from_fn(|c| fresnel_conductor_lanes(cos, eta[c], k[c]))
+                // Three direct calls, not a closure: LLVM inlines neither a closure this
+                // large three times nor the function it lands in (see `lanes::channels`).
+                [
+                    fresnel_conductor_lanes(cos, eta[0], k[0]),
+                    fresnel_conductor_lanes(cos, eta[1], k[1]),
+                    fresnel_conductor_lanes(cos, eta[2], k[2]),
+                ]
             }
             // F0 + (1 − F0)(1 − c)⁵ [Schlick 1994, eq. 15].
             LaneFresnel::Schlick { f0 } => {
                 let m = (R::one() - cos.abs().min(R::one())).max(R::zero());
                 let m5 = m * m * m * m * m;
-                std::array::from_fn(|c| R::splat(f0[c]) + R::splat(1.0 - f0[c]) * m5)
+                channels(|c| R::splat(f0[c]) + R::splat(1.0 - f0[c]) * m5)
             }
         }
     }
@@ -320,7 +326,7 @@ impl LaneBsdf {
                 let same = (wo.z * wi.z).gt(R::zero());
                 let pdf = R::masked(same, wi.z.abs() * R::splat(INV_PI));
                 let v = R::masked(same, R::splat(INV_PI));
-                (colors.tint(reflectance).map(|r| r * v), pdf)
+                (map_channels(colors.tint(reflectance), |r| r * v), pdf)
             }
             LaneBsdf::Conductor { ndf, fresnel, tint } => {
                 let tint = colors.tint(tint);
@@ -334,7 +340,7 @@ impl LaneBsdf {
                 let pdf = ndf.pdf_visible(o, h, d) / (R::splat(4.0) * cos_oh);
                 let f = fresnel.eval(cos_oh);
                 let ok = ok & geom.gt(R::zero());
-                let v = std::array::from_fn(|c| R::masked(ok, tint[c] * f[c] * geom));
+                let v = channels(|c| R::masked(ok, tint[c] * f[c] * geom));
                 (v, R::masked(ok & pdf.is_finite(), pdf))
             }
             LaneBsdf::Dielectric {
@@ -365,7 +371,7 @@ impl LaneBsdf {
                 let (u0, u1) = rng.next_2d(same);
                 let b = Self::il_body(ndf, *ni, o, i, u0, u1);
                 let body = colors.tint(body);
-                let f = std::array::from_fn(|c| R::masked(same, spec + body[c] * b));
+                let f = channels(|c| R::masked(same, spec + body[c] * b));
                 (f, R::masked(same, pdf))
             }
         }
@@ -414,7 +420,7 @@ impl LaneBsdf {
         let value = R::select(refl, fr, ft);
         let pdf = R::select(refl, pr, pt);
         let ok = ok & value.is_finite() & pdf.is_finite();
-        let v = std::array::from_fn(|c| {
+        let v = channels(|c| {
             let tint = R::select(refl, reflect_tint[c], transmit_tint[c]);
             R::masked(ok, tint * value)
         });
@@ -525,7 +531,7 @@ impl LaneBsdf {
                     & w.is_finite();
                 LaneSample {
                     wi: mirror(i, s),
-                    weight: std::array::from_fn(|k| tint[k] * f[k] * w),
+                    weight: channels(|k| tint[k] * f[k] * w),
                     pdf,
                     eta: R::one(),
                     transmitted: R::Mask::splat(false),
@@ -573,7 +579,7 @@ impl LaneBsdf {
                 let (b0, b1) = rng.next_2d(valued);
                 let b = Self::il_body(ndf, *ni, o, i, b0, b1);
                 let k = i.z / pdf;
-                let weight: [R; 3] = std::array::from_fn(|ch| (spec + body[ch] * b) * k);
+                let weight: [R; 3] = channels(|ch| (spec + body[ch] * b) * k);
                 let ok =
                     valued & weight[0].is_finite() & weight[1].is_finite() & weight[2].is_finite();
                 LaneSample {
@@ -661,7 +667,7 @@ impl LaneBsdf {
             & pdf.gt(zero)
             & pdf.is_finite()
             & base.is_finite();
-        let weight = std::array::from_fn(|ch| {
+        let weight = channels(|ch| {
             R::select(
                 choose_r,
                 reflect_tint[ch] * base,

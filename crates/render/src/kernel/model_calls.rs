@@ -9,6 +9,8 @@
 //! one function per lane type, compiled for AVX2 + FMA where the CPU has them: a call per
 //! model group and bounce, nothing next to the model's own work.
 
+#[cfg(target_arch = "x86_64")]
+use facette_bsdf::lanes::F32x8Avx2;
 use facette_bsdf::lanes::{F32x8, F64x8, LVec3, Real};
 use facette_bsdf::models::{ColorSource, LaneBsdf, LaneRandom, LaneSample};
 
@@ -45,9 +47,13 @@ pub(crate) trait ShadingLanes: Real {
 /// f64 lanes (the test that finds the scalar integrator's image): the baseline build.
 impl ShadingLanes for F64x8 {}
 
-/// f32 lanes (renders): the AVX2 + FMA build where the CPU has them (the feature test is
-/// a cached flag), the baseline build elsewhere.
-impl ShadingLanes for F32x8 {
+/// f32 array lanes: the portable build's (where the CPU has no AVX2) and the tests'.
+impl ShadingLanes for F32x8 {}
+
+/// f32 register lanes (renders where the CPU has AVX2 and FMA): each model call compiled
+/// for AVX2 + FMA.
+#[cfg(target_arch = "x86_64")]
+impl ShadingLanes for F32x8Avx2 {
     #[inline(always)]
     fn eval_pdf(
         model: &LaneBsdf,
@@ -56,12 +62,9 @@ impl ShadingLanes for F32x8 {
         wi: LVec3<Self>,
         rng: &mut impl LaneRandom<Self>,
     ) -> ([Self; 3], Self) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2_fma() {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { eval_pdf_avx2(model, colors, wo, wi, rng) };
-        }
-        model.eval_pdf_out_of_line(colors, wo, wi, rng)
+        // SAFETY: register lanes exist only where the CPU has AVX2 and FMA (the rule of
+        // `lanes::avx2`), the features the function is compiled for.
+        unsafe { eval_pdf_avx2(model, colors, wo, wi, rng) }
     }
 
     #[inline(always)]
@@ -74,12 +77,8 @@ impl ShadingLanes for F32x8 {
         u1: Self,
         rng: &mut impl LaneRandom<Self>,
     ) -> LaneSample<Self> {
-        #[cfg(target_arch = "x86_64")]
-        if avx2_fma() {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { sample_avx2(model, colors, wo, u_lobe, u0, u1, rng) };
-        }
-        model.sample_out_of_line(colors, wo, u_lobe, u0, u1, rng)
+        // SAFETY: as in `eval_pdf`.
+        unsafe { sample_avx2(model, colors, wo, u_lobe, u0, u1, rng) }
     }
 }
 
@@ -88,7 +87,7 @@ impl ShadingLanes for F32x8 {
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn avx2_fma() -> bool {
-    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    facette_bsdf::lanes::avx2::available()
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -96,11 +95,11 @@ pub(crate) fn avx2_fma() -> bool {
 #[inline(never)]
 fn eval_pdf_avx2(
     model: &LaneBsdf,
-    colors: &impl ColorSource<F32x8>,
-    wo: LVec3<F32x8>,
-    wi: LVec3<F32x8>,
-    rng: &mut impl LaneRandom<F32x8>,
-) -> ([F32x8; 3], F32x8) {
+    colors: &impl ColorSource<F32x8Avx2>,
+    wo: LVec3<F32x8Avx2>,
+    wi: LVec3<F32x8Avx2>,
+    rng: &mut impl LaneRandom<F32x8Avx2>,
+) -> ([F32x8Avx2; 3], F32x8Avx2) {
     model.eval_pdf_with(colors, wo, wi, rng)
 }
 
@@ -109,12 +108,12 @@ fn eval_pdf_avx2(
 #[inline(never)]
 fn sample_avx2(
     model: &LaneBsdf,
-    colors: &impl ColorSource<F32x8>,
-    wo: LVec3<F32x8>,
-    u_lobe: F32x8,
-    u0: F32x8,
-    u1: F32x8,
-    rng: &mut impl LaneRandom<F32x8>,
-) -> LaneSample<F32x8> {
+    colors: &impl ColorSource<F32x8Avx2>,
+    wo: LVec3<F32x8Avx2>,
+    u_lobe: F32x8Avx2,
+    u0: F32x8Avx2,
+    u1: F32x8Avx2,
+    rng: &mut impl LaneRandom<F32x8Avx2>,
+) -> LaneSample<F32x8Avx2> {
     model.sample_with(colors, wo, u_lobe, u0, u1, rng)
 }

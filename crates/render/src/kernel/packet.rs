@@ -44,7 +44,9 @@ use crate::render::{CameraSampling, PixelSums};
 use crate::sampler::lanes::SampleLanes;
 use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
-use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LFrame, LVec3, Mask, Real, U32x8};
+#[cfg(target_arch = "x86_64")]
+use facette_bsdf::lanes::F32x8Avx2;
+use facette_bsdf::lanes::{channels, Bits32, F32x8, F64x8, LFrame, LVec3, Mask, Real, U32x8};
 use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
 use facette_bsdf::models::{LaneBsdf, LaneColors, LaneRandom, OwnColors};
@@ -93,7 +95,7 @@ type Rgb<S> = [S; 3];
 
 #[inline(always)]
 fn rgb_splat<S: Real>(c: Spectrum) -> Rgb<S> {
-    std::array::from_fn(|k| S::splat(c[k]))
+    channels(|k| S::splat(c[k]))
 }
 
 #[inline(always)]
@@ -315,7 +317,7 @@ pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn render_tile_avx2(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
-    render_tile_lanes::<F32x8, GeometryLanes>(job, sums)
+    render_tile_lanes::<F32x8Avx2, GeometryLanes>(job, sums)
 }
 
 /// The lane type of the renders' geometry (rays, hit records, spawned origins). The kernel
@@ -1461,6 +1463,42 @@ mod tests {
                     "{kind:?} {strategy:?}: {differ} of {} pixels differ",
                     w * h
                 );
+            }
+        }
+    }
+
+    /// The renders' AVX2 build, with its register lanes (`F32x8Avx2`), computes the bits of
+    /// the portable build's array lanes (`F32x8`): every pixel's sums, for every sampler and
+    /// estimator, on a scene with every lane model, textures, both distributions, a
+    /// conductor's complex Fresnel, glass, an area light and a point light.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn the_avx2_build_renders_the_portable_builds_image_bit_for_bit() {
+        if !super::super::model_calls::avx2_fma() {
+            eprintln!("this CPU has no AVX2 + FMA: only the portable build runs here");
+            return;
+        }
+        let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
+        let (w, h) = (scene.film.width, scene.film.height);
+        let chunk: Vec<u32> = (0..8).collect();
+        let never = || false;
+        for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
+            for strategy in [Strategy::Mis, Strategy::NeeOnly, Strategy::BsdfOnly] {
+                let sampler = PixelSampler::new(kind, 5, w, h, 8);
+                let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
+                let (mut portable, mut avx2) = (Vec::new(), Vec::new());
+                render_tile_lanes::<F32x8, GeometryLanes>(&job, &mut portable);
+                // SAFETY: the CPU has AVX2 and FMA (tested above).
+                unsafe { render_tile_avx2(&job, &mut avx2) };
+                assert_eq!(portable.len(), w * h);
+                for (k, (p, q)) in portable.iter().zip(&avx2).enumerate() {
+                    assert_eq!(p.count(), q.count());
+                    let (a, b) = (p.sums(), q.sums());
+                    assert!(
+                        (0..3).all(|c| a[c].to_bits() == b[c].to_bits()),
+                        "{kind:?} {strategy:?}, pixel {k}: {a:?} against {b:?}"
+                    );
+                }
             }
         }
     }

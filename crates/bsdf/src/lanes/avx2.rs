@@ -1,0 +1,592 @@
+//! Eight f32 lanes (and their masks and 32-bit integers) held in AVX registers, every
+//! operation one AVX2 intrinsic: the render kernel's shading lanes in its AVX2 + FMA build.
+//!
+//! Why a second eight-lane type beside the array lanes [`F32x8`](super::F32x8): LLVM turns
+//! the array lanes' loops into vector code only where its SLP vectorizer finds them, and
+//! in the kernel's large functions it left a third of them as 4-wide and scalar code
+//! (measured on `bench-sphere`: 705 256-bit, 172 128-bit and 250 scalar floating-point
+//! instructions a sample). Here a value is an `__m256` from the start, so there is nothing
+//! left to find. The two types compute the same bits: the same IEEE operations, no fused
+//! multiply-add, and the transcendental functions from one source
+//! ([`f32_polynomials`](super::f32_polynomials)); a test compares them operation by
+//! operation.
+//!
+//! **Where these types may be used.** Their methods are `#[inline(always)]` wrappers of
+//! AVX2 intrinsics, compiled into whatever function they are inlined in. They are only
+//! correct inside code that runs after [`available`] returned true (the kernel's
+//! `#[target_feature(enable = "avx2,fma")]` build, which the renderer enters after that
+//! test); on a CPU without AVX2 any use is an illegal instruction. The trait methods
+//! cannot be `unsafe` (they implement [`Real`], which the one-source models are written
+//! over), so this rule is the caller's, like the renderer's feature test itself.
+
+use super::f32_polynomials::{self, F32Lanes};
+use super::{Bits32, CellTable, Mask, Real};
+use std::arch::x86_64::*;
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
+
+/// Whether this CPU runs AVX2 and FMA: the condition for using this module's types (the
+/// test is cached by the standard library).
+#[inline(always)]
+pub fn available() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// Eight f32 lanes in one AVX register.
+#[derive(Clone, Copy, Debug)]
+#[repr(transparent)]
+pub struct F32x8Avx2(pub __m256);
+
+/// Eight lane booleans (all bits set or clear per lane) in one AVX register, the form
+/// `vcmpps` makes and `vblendvps` reads.
+#[derive(Clone, Copy, Debug)]
+#[repr(transparent)]
+pub struct M32x8Avx2(pub __m256);
+
+/// Eight u32 lanes in one AVX register.
+#[derive(Clone, Copy, Debug)]
+#[repr(transparent)]
+pub struct U32x8Avx2(pub __m256i);
+
+// SAFETY of every `unsafe` block below: the intrinsics need AVX2 (and FMA for none of
+// them); the module's rule is that these types are used only where the CPU has AVX2.
+
+impl F32x8Avx2 {
+    /// The lanes as an array.
+    #[inline(always)]
+    pub fn to_array(self) -> [f32; 8] {
+        // SAFETY: both are 32 bytes of plain numbers.
+        unsafe { std::mem::transmute::<__m256, [f32; 8]>(self.0) }
+    }
+    /// The lanes of an array.
+    #[inline(always)]
+    pub fn from_array(a: [f32; 8]) -> Self {
+        // SAFETY: both are 32 bytes of plain numbers.
+        F32x8Avx2(unsafe { std::mem::transmute::<[f32; 8], __m256>(a) })
+    }
+    #[inline(always)]
+    fn cmp<const OP: i32>(self, o: Self) -> M32x8Avx2 {
+        M32x8Avx2(unsafe { _mm256_cmp_ps::<OP>(self.0, o.0) })
+    }
+}
+
+impl U32x8Avx2 {
+    /// The lanes as an array.
+    #[inline(always)]
+    pub fn to_array(self) -> [u32; 8] {
+        // SAFETY: both are 32 bytes of plain numbers.
+        unsafe { std::mem::transmute::<__m256i, [u32; 8]>(self.0) }
+    }
+    /// The lanes of an array.
+    #[inline(always)]
+    pub fn from_array(a: [u32; 8]) -> Self {
+        // SAFETY: both are 32 bytes of plain numbers.
+        U32x8Avx2(unsafe { std::mem::transmute::<[u32; 8], __m256i>(a) })
+    }
+}
+
+macro_rules! float_op {
+    ($tr:ident, $f:ident, $intrinsic:ident) => {
+        impl $tr for F32x8Avx2 {
+            type Output = F32x8Avx2;
+            #[inline(always)]
+            fn $f(self, o: F32x8Avx2) -> F32x8Avx2 {
+                F32x8Avx2(unsafe { $intrinsic(self.0, o.0) })
+            }
+        }
+    };
+}
+float_op!(Add, add, _mm256_add_ps);
+float_op!(Sub, sub, _mm256_sub_ps);
+float_op!(Mul, mul, _mm256_mul_ps);
+float_op!(Div, div, _mm256_div_ps);
+
+impl Neg for F32x8Avx2 {
+    type Output = F32x8Avx2;
+    #[inline(always)]
+    fn neg(self) -> F32x8Avx2 {
+        F32x8Avx2(unsafe { _mm256_xor_ps(self.0, _mm256_set1_ps(-0.0)) })
+    }
+}
+
+macro_rules! mask_op {
+    ($tr:ident, $f:ident, $intrinsic:ident) => {
+        impl $tr for M32x8Avx2 {
+            type Output = M32x8Avx2;
+            #[inline(always)]
+            fn $f(self, o: M32x8Avx2) -> M32x8Avx2 {
+                M32x8Avx2(unsafe { $intrinsic(self.0, o.0) })
+            }
+        }
+    };
+}
+mask_op!(BitAnd, bitand, _mm256_and_ps);
+mask_op!(BitOr, bitor, _mm256_or_ps);
+
+impl Not for M32x8Avx2 {
+    type Output = M32x8Avx2;
+    #[inline(always)]
+    fn not(self) -> M32x8Avx2 {
+        M32x8Avx2(unsafe { _mm256_xor_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) })
+    }
+}
+
+impl Mask for M32x8Avx2 {
+    #[inline(always)]
+    fn splat(b: bool) -> Self {
+        M32x8Avx2(unsafe { _mm256_castsi256_ps(_mm256_set1_epi32(-(b as i32))) })
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.lane_bits() != 0
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self.lane_bits() == 0xFF
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> bool {
+        (self.lane_bits() >> i) & 1 != 0
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> bool) -> Self {
+        let mut a = [0u32; 8];
+        for (i, v) in a.iter_mut().enumerate() {
+            *v = if f(i) { !0 } else { 0 };
+        }
+        M32x8Avx2(unsafe { _mm256_castsi256_ps(U32x8Avx2::from_array(a).0) })
+    }
+    #[inline(always)]
+    fn lane_bits(self) -> u32 {
+        unsafe { _mm256_movemask_ps(self.0) as u32 }
+    }
+    #[inline(always)]
+    fn from_lane_bits(bits: u32) -> Self {
+        unsafe {
+            let lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bit);
+            M32x8Avx2(_mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane_bit)))
+        }
+    }
+    #[inline(always)]
+    fn width() -> usize {
+        8
+    }
+}
+
+impl Real for F32x8Avx2 {
+    type Mask = M32x8Avx2;
+    const LANES: usize = 8;
+    const TINY: f64 = 1e-30;
+    const DIGITS: u32 = f32::MANTISSA_DIGITS;
+
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        F32x8Avx2(unsafe { _mm256_set1_ps(v as f32) })
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        self.to_array()[i] as f64
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+        let mut a = [0f32; 8];
+        for (i, v) in a.iter_mut().enumerate() {
+            *v = f(i) as f32;
+        }
+        Self::from_array(a)
+    }
+    /// In place: a scalar store to the lane (as the array lanes do; rebuilding the register
+    /// from a copy stalls store forwarding where it is read back at once).
+    #[inline(always)]
+    fn set_lane(&mut self, i: usize, v: f64) {
+        assert!(i < 8);
+        // SAFETY: lane i < 8 of the 32-byte register value, which is 32 bytes of f32.
+        unsafe {
+            (&mut self.0 as *mut __m256 as *mut f32)
+                .add(i)
+                .write(v as f32)
+        }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        F32x8Avx2(unsafe { _mm256_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        F32x8Avx2(unsafe {
+            _mm256_and_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(i32::MAX)))
+        })
+    }
+    /// `self < o ? self : o` (`vminps`: a NaN `self` yields `o`), as the array lanes.
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        F32x8Avx2(unsafe { _mm256_min_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        F32x8Avx2(unsafe { _mm256_max_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M32x8Avx2 {
+        self.cmp::<_CMP_LT_OQ>(o)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M32x8Avx2 {
+        self.cmp::<_CMP_LE_OQ>(o)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> M32x8Avx2 {
+        self.cmp::<_CMP_GT_OQ>(o)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> M32x8Avx2 {
+        self.cmp::<_CMP_GE_OQ>(o)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M32x8Avx2 {
+        self.cmp::<_CMP_EQ_OQ>(o)
+    }
+    #[inline(always)]
+    fn select(m: M32x8Avx2, a: Self, b: Self) -> Self {
+        F32x8Avx2(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        F32x8Avx2(unsafe { _mm256_floor_ps(self.0) })
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        f32_polynomials::sin_cos(self)
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        f32_polynomials::exp(self)
+    }
+    #[inline(always)]
+    fn ln(self) -> Self {
+        f32_polynomials::ln(self)
+    }
+    /// x − x = 0 (NaN for ±∞ and NaN): one subtraction and one compare.
+    #[inline(always)]
+    fn is_finite(self) -> M32x8Avx2 {
+        let difference = F32x8Avx2(unsafe { _mm256_sub_ps(self.0, self.0) });
+        difference.eq(Self::zero())
+    }
+    /// One 16-byte load of the cell's four numbers per lane and a transpose of the eight
+    /// loads into four registers. The index is the truncated lane (`vcvttps2dq`): a
+    /// negative, huge or NaN lane indexes out of bounds (a panic, never a wrong cell).
+    #[inline(always)]
+    fn gather4(table: &CellTable, cell: Self) -> [Self; 4] {
+        let cells = table.f32_cells();
+        let index = U32x8Avx2(unsafe { _mm256_cvttps_epi32(cell.0) }).to_array();
+        let row = |i: usize| unsafe { _mm_loadu_ps(cells[index[i] as usize].as_ptr()) };
+        unsafe {
+            // a_k holds cell k in its low half and cell k + 4 in its high half; the 4 × 4
+            // transposes of the two halves then give the four numbers' lanes.
+            let a0 = _mm256_set_m128(row(4), row(0));
+            let a1 = _mm256_set_m128(row(5), row(1));
+            let a2 = _mm256_set_m128(row(6), row(2));
+            let a3 = _mm256_set_m128(row(7), row(3));
+            let t0 = _mm256_unpacklo_ps(a0, a1);
+            let t1 = _mm256_unpacklo_ps(a2, a3);
+            let t2 = _mm256_unpackhi_ps(a0, a1);
+            let t3 = _mm256_unpackhi_ps(a2, a3);
+            [
+                F32x8Avx2(_mm256_shuffle_ps::<0x44>(t0, t1)),
+                F32x8Avx2(_mm256_shuffle_ps::<0xEE>(t0, t1)),
+                F32x8Avx2(_mm256_shuffle_ps::<0x44>(t2, t3)),
+                F32x8Avx2(_mm256_shuffle_ps::<0xEE>(t2, t3)),
+            ]
+        }
+    }
+}
+
+impl F32Lanes for F32x8Avx2 {
+    type Bits = U32x8Avx2;
+    #[inline(always)]
+    fn to_bits(self) -> U32x8Avx2 {
+        U32x8Avx2(unsafe { _mm256_castps_si256(self.0) })
+    }
+    #[inline(always)]
+    fn from_bits(b: U32x8Avx2) -> Self {
+        F32x8Avx2(unsafe { _mm256_castsi256_ps(b.0) })
+    }
+    #[inline(always)]
+    fn from_i32(b: U32x8Avx2) -> Self {
+        F32x8Avx2(unsafe { _mm256_cvtepi32_ps(b.0) })
+    }
+    #[inline(always)]
+    fn mask_from_bits(b: U32x8Avx2) -> M32x8Avx2 {
+        M32x8Avx2(unsafe { _mm256_castsi256_ps(b.0) })
+    }
+}
+
+macro_rules! int_op {
+    ($tr:ident, $f:ident, $intrinsic:ident) => {
+        impl $tr for U32x8Avx2 {
+            type Output = U32x8Avx2;
+            #[inline(always)]
+            fn $f(self, o: U32x8Avx2) -> U32x8Avx2 {
+                U32x8Avx2(unsafe { $intrinsic(self.0, o.0) })
+            }
+        }
+    };
+}
+int_op!(BitAnd, bitand, _mm256_and_si256);
+int_op!(BitOr, bitor, _mm256_or_si256);
+int_op!(BitXor, bitxor, _mm256_xor_si256);
+
+impl Bits32 for U32x8Avx2 {
+    const LANES: usize = 8;
+    #[inline(always)]
+    fn splat(v: u32) -> Self {
+        U32x8Avx2(unsafe { _mm256_set1_epi32(v as i32) })
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> u32 {
+        self.to_array()[i]
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> u32) -> Self {
+        let mut a = [0u32; 8];
+        for (i, v) in a.iter_mut().enumerate() {
+            *v = f(i);
+        }
+        Self::from_array(a)
+    }
+    #[inline(always)]
+    fn wrapping_add(self, o: Self) -> Self {
+        U32x8Avx2(unsafe { _mm256_add_epi32(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn wrapping_sub(self, o: Self) -> Self {
+        U32x8Avx2(unsafe { _mm256_sub_epi32(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn wrapping_mul(self, o: Self) -> Self {
+        U32x8Avx2(unsafe { _mm256_mullo_epi32(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn shl(self, n: u32) -> Self {
+        U32x8Avx2(unsafe { _mm256_sll_epi32(self.0, _mm_cvtsi32_si128(n as i32)) })
+    }
+    #[inline(always)]
+    fn shr(self, n: u32) -> Self {
+        U32x8Avx2(unsafe { _mm256_srl_epi32(self.0, _mm_cvtsi32_si128(n as i32)) })
+    }
+    #[inline(always)]
+    fn shr_lanes(self, n: Self) -> Self {
+        U32x8Avx2(unsafe {
+            _mm256_srlv_epi32(self.0, _mm256_and_si256(n.0, _mm256_set1_epi32(31)))
+        })
+    }
+    /// The top 24 bits (f32) or all 32 bits (f64) of each lane as a fraction in [0, 1): one
+    /// shift and one conversion for f32 lanes (the shifted value is below 2²⁴, exact).
+    #[inline(always)]
+    fn unit<R: Real>(self) -> R {
+        if R::DIGITS < 32 {
+            let f = unsafe {
+                _mm256_mul_ps(
+                    _mm256_cvtepi32_ps(_mm256_srli_epi32::<8>(self.0)),
+                    _mm256_set1_ps(1.0 / 16_777_216.0),
+                )
+            };
+            let a = F32x8Avx2(f).to_array();
+            R::from_fn(|i| a[i] as f64)
+        } else {
+            let a = self.to_array();
+            R::from_fn(|i| a[i] as f64 * (1.0 / 4_294_967_296.0))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lanes::{F32x8, U32x8};
+
+    /// Values with every kind of edge: signed zeros, subnormals, infinities, NaN, integers
+    /// and halves, the Cephes functions' ranges, and pseudo-random bits.
+    fn values() -> Vec<f32> {
+        let mut v = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            1e-40,
+            -1e-40,
+            1e-30,
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            3.0e7,
+            -88.0,
+            89.0,
+            6.2,
+            100.0,
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for k in 0..4000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let bits = (state >> 32) as u32;
+            v.push(match k % 3 {
+                0 => f32::from_bits(bits),
+                1 => (bits >> 8) as f32 / 16_777_216.0 * 20.0 - 10.0,
+                _ => (bits >> 8) as f32 / 16_777_216.0 * 200.0 - 100.0,
+            });
+        }
+        v
+    }
+
+    fn chunks(v: &[f32]) -> Vec<[f32; 8]> {
+        v.chunks(8)
+            .map(|c| std::array::from_fn(|i| c[i % c.len()]))
+            .collect()
+    }
+
+    fn same(a: F32x8, b: F32x8Avx2, what: &str, x: [f32; 8]) {
+        let (a, b) = (a.0, b.to_array());
+        for i in 0..8 {
+            // NaN payloads may differ between the scalar and vector forms of an operation.
+            let ok = a[i].to_bits() == b[i].to_bits() || (a[i].is_nan() && b[i].is_nan());
+            assert!(
+                ok,
+                "{what} of {:e}: array {:e}, avx2 {:e}",
+                x[i], a[i], b[i]
+            );
+        }
+    }
+
+    /// Every operation of the register lanes gives the array lanes' bits, on edge values and
+    /// random ones, in pairs shifted against each other.
+    #[test]
+    fn register_lanes_compute_the_array_lanes_bits() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let v = values();
+        let xs = chunks(&v);
+        let ys = chunks(&v[3..]);
+        for (x, y) in xs.iter().zip(&ys) {
+            let (a, b) = (F32x8(*x), F32x8(*y));
+            let (p, q) = (F32x8Avx2::from_array(*x), F32x8Avx2::from_array(*y));
+            same(a + b, p + q, "add", *x);
+            same(a - b, p - q, "sub", *x);
+            same(a * b, p * q, "mul", *x);
+            same(a / b, p / q, "div", *x);
+            same(-a, -p, "neg", *x);
+            same(a.sqrt(), p.sqrt(), "sqrt", *x);
+            same(a.abs(), p.abs(), "abs", *x);
+            same(a.min(b), p.min(q), "min", *x);
+            same(a.max(b), p.max(q), "max", *x);
+            same(a.floor(), p.floor(), "floor", *x);
+            same(a.exp(), p.exp(), "exp", *x);
+            same(a.ln(), p.ln(), "ln", *x);
+            let (s, c) = a.sin_cos();
+            let (s2, c2) = p.sin_cos();
+            same(s, s2, "sin", *x);
+            same(c, c2, "cos", *x);
+            same(a.clamp(-2.0, 3.0), p.clamp(-2.0, 3.0), "clamp", *x);
+            for (m, n, what) in [
+                (a.lt(b), p.lt(q), "lt"),
+                (a.le(b), p.le(q), "le"),
+                (a.gt(b), p.gt(q), "gt"),
+                (a.ge(b), p.ge(q), "ge"),
+                (a.eq(b), p.eq(q), "eq"),
+                (a.is_finite(), p.is_finite(), "is_finite"),
+            ] {
+                assert_eq!(m.lane_bits(), n.lane_bits(), "{what} of {x:?}, {y:?}");
+                same(F32x8::select(m, a, b), F32x8Avx2::select(n, p, q), what, *x);
+                assert_eq!((!m).lane_bits(), (!n).lane_bits());
+                let other = a.lt(F32x8::zero());
+                let other2 = p.lt(F32x8Avx2::zero());
+                assert_eq!((m & other).lane_bits(), (n & other2).lane_bits());
+                assert_eq!((m | other).lane_bits(), (n | other2).lane_bits());
+                assert_eq!(
+                    M32x8Avx2::from_lane_bits(n.lane_bits()).lane_bits(),
+                    n.lane_bits()
+                );
+                for i in 0..8 {
+                    assert_eq!(m.lane(i), n.lane(i));
+                }
+            }
+        }
+        assert!(M32x8Avx2::splat(true).all() && M32x8Avx2::splat(false).none());
+        let mut p = F32x8Avx2::splat(1.0);
+        p.set_lane(5, 7.0);
+        assert_eq!(p.to_array(), [1.0, 1.0, 1.0, 1.0, 1.0, 7.0, 1.0, 1.0]);
+        assert_eq!(F32x8Avx2::from_fn(|i| i as f64).lane(6), 6.0);
+    }
+
+    #[test]
+    fn register_integers_compute_the_array_integers_bits() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let v: Vec<u32> = values().iter().map(|x| x.to_bits()).collect();
+        for (x, y) in v.chunks_exact(8).zip(v[5..].chunks_exact(8)) {
+            let x: [u32; 8] = x.try_into().unwrap();
+            let y: [u32; 8] = y.try_into().unwrap();
+            let (a, b) = (U32x8(x), U32x8(y));
+            let (p, q) = (U32x8Avx2::from_array(x), U32x8Avx2::from_array(y));
+            let pairs = [
+                (a.wrapping_add(b), p.wrapping_add(q)),
+                (a.wrapping_sub(b), p.wrapping_sub(q)),
+                (a.wrapping_mul(b), p.wrapping_mul(q)),
+                (a & b, p & q),
+                (a | b, p | q),
+                (a ^ b, p ^ q),
+                (a.shl(7), p.shl(7)),
+                (a.shr(13), p.shr(13)),
+                (a.shr_lanes(b), p.shr_lanes(q)),
+                (a.reverse(), p.reverse()),
+            ];
+            for (k, (r, s)) in pairs.iter().enumerate() {
+                assert_eq!(r.0, s.to_array(), "operation {k} of {x:?}, {y:?}");
+            }
+            assert_eq!(
+                a.unit::<F32x8>().0,
+                p.unit::<F32x8Avx2>().to_array(),
+                "unit of {x:?}"
+            );
+            let f64s: [f64; 8] = std::array::from_fn(|i| a.unit::<crate::lanes::F64x8>().0[i]);
+            assert_eq!(f64s, p.unit::<crate::lanes::F64x8>().0);
+        }
+    }
+
+    /// The register gather reads the same cells as the array lanes' and transposes them.
+    #[test]
+    fn register_gather_reads_each_lanes_cell() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let table = CellTable::new(
+            (0..50)
+                .map(|k| std::array::from_fn(|j| (k * 4 + j) as f64 + 0.25))
+                .collect(),
+        );
+        let cells = [0.0, 49.0, 3.7, 12.2, 7.0, 48.9, 0.5, 25.0];
+        let a = F32x8::gather4(&table, F32x8(cells));
+        let p = F32x8Avx2::gather4(&table, F32x8Avx2::from_array(cells));
+        for k in 0..4 {
+            assert_eq!(a[k].0, p[k].to_array(), "number {k}");
+        }
+        assert_eq!(p[2].lane(1), (49 * 4 + 2) as f64 + 0.25);
+        let out = std::panic::catch_unwind(|| {
+            F32x8Avx2::gather4(&table, F32x8Avx2::splat(f64::NAN));
+        });
+        assert!(out.is_err(), "a NaN cell index must not read a cell");
+    }
+}
