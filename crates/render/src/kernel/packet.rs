@@ -9,8 +9,9 @@
 //! shading frame; light samples; the materials' values and densities for them; shadow rays
 //! (one packet query); the materials' samples; throughput, roulette and the next rays.
 //!
-//! Everything in lanes is in one lane type `S`: [`F32x8`] in renders, [`F64x8`] in the test
-//! that finds the scalar integrator's image sample for sample. That covers the geometry —
+//! Everything in lanes is in f32 lanes in renders — `F32x8Avx2` (AVX registers) in the AVX2
+//! build, [`F32x8`] (arrays, the same bits) in the portable one — and in [`F64x8`] in the
+//! test that finds the scalar integrator's image sample for sample. That covers the geometry —
 //! rays, hit points, normals, frames, spawned origins, computed by the same one-source
 //! functions as the scalar integrator's (the sphere test and record, the camera, the
 //! spawning rule with the offset of the lanes' precision, the frame) — and the shading —
@@ -30,7 +31,8 @@
 //! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than a constant environment and point
 //! lights, environment maps, area-light emission, ray differentials. On x86-64 the kernel
 //! is compiled twice, for the baseline (SSE2: an 8-lane f32 operation is two instructions)
-//! and for AVX2 + FMA, chosen at run time.
+//! and for AVX2 + FMA with the register lanes, chosen at run time; the two give the same
+//! image bit for bit (tested).
 
 use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
@@ -46,7 +48,7 @@ use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
 #[cfg(target_arch = "x86_64")]
 use facette_bsdf::lanes::F32x8Avx2;
-use facette_bsdf::lanes::{channels, Bits32, F32x8, F64x8, LFrame, LVec3, Mask, Real, U32x8};
+use facette_bsdf::lanes::{channels, Bits32, F32x8, LFrame, LVec3, Mask, Real, U32x8};
 use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
 use facette_bsdf::models::{LaneBsdf, LaneColors, LaneRandom, OwnColors};
@@ -317,20 +319,23 @@ pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn render_tile_avx2(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
-    render_tile_lanes::<F32x8Avx2, GeometryLanes>(job, sums)
+    render_tile_lanes::<F32x8Avx2, F32x8Avx2>(job, sums)
 }
 
-/// The lane type of the renders' geometry (rays, hit records, spawned origins). The kernel
-/// runs with f32 geometry too (the spawning rule's f32 offset, tested off spheres and
-/// meshes far from the origin, and an image test against f64 geometry), but LLVM's
-/// vectorizer turns the kernel's `[f32; 8]` lanes into 4-wide and scalar code where it
-/// keeps `[f64; 8]` as two 4-wide registers: measured on `bench-sphere`, f32 geometry ran
-/// 2,191 instructions a sample against 2,026 and 1.87 s against 1.74 s of one thread
-/// (docs/performance.md). It stays f64 until the f32 lanes compile to 8-wide code.
-type GeometryLanes = F64x8;
+/// The lane type of the portable build's geometry (rays, hit records, spawned origins): f32,
+/// like its shading lanes; the AVX2 build's is `F32x8Avx2`, which computes the same bits,
+/// so that an image (and each part of a `--part K/N` run) is the same on every x86-64 CPU.
+/// f32 geometry spawns rays with the f32 offset (`geometry::ray`, tested off spheres and
+/// meshes far from the origin) and renders the image of f64 geometry within rounding (the
+/// test below). With the register lanes it costs 1,371 instructions a bench-sphere sample
+/// against 1,741 with `F64x8` geometry (two registers per value); with the array lanes it
+/// had cost more than f64, because LLVM left much of its `[f32; 8]` code 4-wide and scalar
+/// (docs/performance.md).
+type GeometryLanes = F32x8;
 
 /// [`render_tile`] with shading lanes `S` and geometry lanes `G` (8 lanes each: `F32x8`
-/// and [`GeometryLanes`] in renders; `F64x8` for both in the test that finds the scalar
+/// and [`GeometryLanes`] in the portable build's renders, `F32x8Avx2` for both in the AVX2
+/// build's; `F64x8` for both in the test that finds the scalar
 /// integrator's image, `F32x8` for both in the test of f32 geometry).
 #[inline(always)]
 pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
@@ -1267,6 +1272,7 @@ impl LaneCompare for U32x8 {
 mod tests {
     use super::*;
     use crate::integrator::radiance;
+    use facette_bsdf::lanes::F64x8;
     use crate::sampler::SamplerKind;
     use crate::scene::load_scene_str;
 
