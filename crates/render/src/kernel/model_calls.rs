@@ -9,14 +9,17 @@
 //! one function per lane type, compiled for AVX2 + FMA where the CPU has them: a call per
 //! model group and bounce, nothing next to the model's own work.
 
+use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LVec3, Real, U32x8};
 #[cfg(target_arch = "x86_64")]
-use facette_bsdf::lanes::F32x8Avx2;
-use facette_bsdf::lanes::{F32x8, F64x8, LVec3, Real};
+use facette_bsdf::lanes::{F32x8Avx2, U32x8Avx2};
 use facette_bsdf::models::{ColorSource, LaneBsdf, LaneRandom, LaneSample};
 
 /// A lane type the kernel shades with, and how it calls the lane models: by default their
 /// baseline out-of-line functions.
 pub(crate) trait ShadingLanes: Real {
+    /// The 32-bit integer lanes of the same build (the samplers' hashes).
+    type Bits: Bits32;
+
     /// [`LaneBsdf::eval_pdf`], out of line.
     #[inline(always)]
     fn eval_pdf(
@@ -45,15 +48,21 @@ pub(crate) trait ShadingLanes: Real {
 }
 
 /// f64 lanes (the test that finds the scalar integrator's image): the baseline build.
-impl ShadingLanes for F64x8 {}
+impl ShadingLanes for F64x8 {
+    type Bits = U32x8;
+}
 
 /// f32 array lanes: the portable build's (where the CPU has no AVX2) and the tests'.
-impl ShadingLanes for F32x8 {}
+impl ShadingLanes for F32x8 {
+    type Bits = U32x8;
+}
 
 /// f32 register lanes (renders where the CPU has AVX2 and FMA): each model call compiled
 /// for AVX2 + FMA.
 #[cfg(target_arch = "x86_64")]
 impl ShadingLanes for F32x8Avx2 {
+    type Bits = U32x8Avx2;
+
     #[inline(always)]
     fn eval_pdf(
         model: &LaneBsdf,

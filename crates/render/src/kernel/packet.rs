@@ -487,7 +487,7 @@ enum VertexBsdf<'s> {
 impl<'s> Kernel<'s> {
     /// Fills the empty lanes with camera rays, making a new batch when the last is used up.
     #[inline(always)]
-    fn refill<S: Real, G: Real>(
+    fn refill<S: ShadingLanes, G: Real>(
         &self,
         paths: &mut Paths<S, G>,
         batch: &mut CameraBatch<G>,
@@ -534,7 +534,11 @@ impl<'s> Kernel<'s> {
 
     /// The camera rays of the next (up to) eight jobs; `false` when no job is left.
     #[inline(always)]
-    fn make_batch<S: Real, G: Real>(&self, batch: &mut CameraBatch<G>, jobs: &mut Jobs) -> bool {
+    fn make_batch<S: ShadingLanes, G: Real>(
+        &self,
+        batch: &mut CameraBatch<G>,
+        jobs: &mut Jobs,
+    ) -> bool {
         let mut px = [0.0; LANES];
         let mut py = [0.0; LANES];
         let mut n = 0;
@@ -560,7 +564,7 @@ impl<'s> Kernel<'s> {
             .make(active & !batch.samples.fast(), self.sampler);
         let scene = self.scene;
         // The filter offset (dimensions 0, 1), then the lens position (2, 3) where read.
-        let (u0, u1) = self.sampler.get_lanes::<S>(
+        let (u0, u1) = self.sampler.get_lanes::<S, S::Bits>(
             &batch.samples,
             batch.streams.all(),
             U32x8::splat(0),
@@ -571,7 +575,7 @@ impl<'s> Kernel<'s> {
         let fx = G::from_fn(|i| px[i]) + conv(ox);
         let fy = G::from_fn(|i| py[i]) + conv(oy);
         let lens = if scene.camera.has_lens() {
-            let (l0, l1) = self.sampler.get_lanes::<S>(
+            let (l0, l1) = self.sampler.get_lanes::<S, S::Bits>(
                 &batch.samples,
                 batch.streams.all(),
                 U32x8::splat(2),
@@ -857,13 +861,13 @@ impl<'s> Kernel<'s> {
         let selector = &scene.selector;
         let u_select = if selector.reads_selection_number() {
             self.sampler
-                .get_lanes::<S>(&paths.samples, paths.streams.all(), block, set, false)
+                .get_lanes::<S, S::Bits>(&paths.samples, paths.streams.all(), block, set, false)
                 .0
         } else {
             S::splat(0.5)
         };
         let (u0, u1) = if selector.reads_position_numbers() {
-            self.sampler.get_lanes::<S>(
+            self.sampler.get_lanes::<S, S::Bits>(
                 &paths.samples,
                 paths.streams.all(),
                 block.wrapping_add(U32x8::splat(1)),
@@ -1094,7 +1098,7 @@ impl<'s> Kernel<'s> {
             let lobe_set = vertex.reads_lobe & live;
             let u_lobe = if lobe_set != 0 {
                 self.sampler
-                    .get_lanes::<S>(
+                    .get_lanes::<S, S::Bits>(
                         &paths.samples,
                         paths.streams.all(),
                         block.wrapping_add(U32x8::splat(3)),
@@ -1105,7 +1109,7 @@ impl<'s> Kernel<'s> {
             } else {
                 S::splat(0.5)
             };
-            let (u0, u1) = self.sampler.get_lanes::<S>(
+            let (u0, u1) = self.sampler.get_lanes::<S, S::Bits>(
                 &paths.samples,
                 paths.streams.all(),
                 block.wrapping_add(U32x8::splat(4)),
@@ -1190,7 +1194,7 @@ impl<'s> Kernel<'s> {
             let q = q.min(S::splat(0.95));
             let u = self
                 .sampler
-                .get_lanes::<S>(
+                .get_lanes::<S, S::Bits>(
                     &paths.samples,
                     paths.streams.all(),
                     block.wrapping_add(U32x8::splat(6)),
@@ -1272,9 +1276,9 @@ impl LaneCompare for U32x8 {
 mod tests {
     use super::*;
     use crate::integrator::radiance;
-    use facette_bsdf::lanes::F64x8;
     use crate::sampler::SamplerKind;
     use crate::scene::load_scene_str;
+    use facette_bsdf::lanes::F64x8;
 
     const SCENE: &str = r#"
         [camera]

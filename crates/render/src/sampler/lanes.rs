@@ -89,9 +89,11 @@ impl PixelSampler {
 
     /// Each lane of `active`'s value of its dimension `dims[i]` (and of `dims[i] + 1` as the
     /// second coordinate where `pair`): the values of `streams[i].get_1d` / `get_2d` at that
-    /// dimension, in lanes of `S` (never 1). Inactive lanes hold a harmless ½.
+    /// dimension, in lanes of `S` (never 1). Inactive lanes hold a harmless ½. The hashes
+    /// run in the integer lanes `B` (`U32x8` or, in the kernel's AVX2 build, the register
+    /// lanes `U32x8Avx2`: the same bits).
     #[inline(always)]
-    pub(crate) fn get_lanes<S: Real>(
+    pub(crate) fn get_lanes<S: Real, B: Bits32>(
         &self,
         lanes: &SampleLanes,
         streams: &mut [SampleStream],
@@ -99,7 +101,7 @@ impl PixelSampler {
         active: u8,
         pair: bool,
     ) -> (S, S) {
-        let words = |k: usize| U32x8(lanes.words[k]);
+        let words = |k: usize| B::from_fn(|i| lanes.words[k][i]);
         let (x, y) = match &self.layout {
             Layout::Sobol(z) if !self.dim_seeds.is_empty() => {
                 let seeds = |i: usize| {
@@ -111,14 +113,16 @@ impl PixelSampler {
                 };
                 let s: [DimSeeds; 8] = std::array::from_fn(seeds);
                 let seeds = [
-                    U32x8::from_fn(|i| s[i].field),
-                    U32x8::from_fn(|i| s[i].s0),
-                    U32x8::from_fn(|i| s[i].s1),
+                    B::from_fn(|i| s[i].field),
+                    B::from_fn(|i| s[i].s0),
+                    B::from_fn(|i| s[i].s1),
                 ];
                 short_index_point(words(0), z.index_bits(), seeds, pair)
             }
-            Layout::Independent => independent_point([words(0), words(1)], dims),
-            _ => (U32x8::splat(1 << 31), U32x8::splat(1 << 31)),
+            Layout::Independent => {
+                independent_point([words(0), words(1)], B::from_fn(|i| dims.lane(i)))
+            }
+            _ => (B::splat(1 << 31), B::splat(1 << 31)),
         };
         let (mut x, mut y): (S, S) = (x.unit(), y.unit());
         let slow = active & !lanes.fast;
@@ -208,9 +212,22 @@ mod tests {
                 for pair in [false, true] {
                     let active = 0b1011_1101;
                     let (x, y) =
-                        sampler.get_lanes::<F64x8>(&lanes, &mut streams, dims, active, pair);
+                        sampler.get_lanes::<F64x8, U32x8>(&lanes, &mut streams, dims, active, pair);
                     let (x32, y32) =
-                        sampler.get_lanes::<F32x8>(&lanes, &mut streams, dims, active, pair);
+                        sampler.get_lanes::<F32x8, U32x8>(&lanes, &mut streams, dims, active, pair);
+                    // The AVX2 build's register lanes hash to the same bits.
+                    #[cfg(target_arch = "x86_64")]
+                    if facette_bsdf::lanes::avx2::available() {
+                        use facette_bsdf::lanes::{F32x8Avx2, U32x8Avx2};
+                        let (xr, yr) = sampler.get_lanes::<F32x8Avx2, U32x8Avx2>(
+                            &lanes,
+                            &mut streams,
+                            dims,
+                            active,
+                            pair,
+                        );
+                        assert_eq!((xr.to_array(), yr.to_array()), (x32.0, y32.0), "{kind:?}");
+                    }
                     for i in (0..8).filter(|i| active & (1 << i) != 0) {
                         let mut st = streams[i].clone();
                         st.set_dimension(dims.lane(i));
