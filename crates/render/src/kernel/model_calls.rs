@@ -91,14 +91,6 @@ impl ShadingLanes for F32x8Avx2 {
     }
 }
 
-/// Whether this CPU runs AVX2 and FMA (what [`render_tile`](super::packet::render_tile)
-/// tests to choose its build).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub(crate) fn avx2_fma() -> bool {
-    facette_bsdf::lanes::avx2::available()
-}
-
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline(never)]

@@ -309,7 +309,7 @@ pub(crate) struct TileJob<'a> {
 /// number of rows started (a stop leaves the later rows out).
 pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     #[cfg(target_arch = "x86_64")]
-    if super::model_calls::avx2_fma() {
+    if facette_bsdf::lanes::avx2::available() {
         // SAFETY: the CPU has the features the function is compiled for.
         return unsafe { render_tile_avx2(job, sums) };
     }
@@ -1484,7 +1484,7 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn the_avx2_build_renders_the_portable_builds_image_bit_for_bit() {
-        if !super::super::model_calls::avx2_fma() {
+        if !facette_bsdf::lanes::avx2::available() {
             eprintln!("this CPU has no AVX2 + FMA: only the portable build runs here");
             return;
         }
