@@ -380,6 +380,30 @@ impl Bits32 for U32x8Avx2 {
             _mm256_srlv_epi32(self.0, _mm256_and_si256(n.0, _mm256_set1_epi32(31)))
         })
     }
+    /// One `vpgatherdd` after one bounds test of the eight indices (unsigned minimum and
+    /// compare): an index outside the table panics before anything is read, and a table
+    /// beyond 2³¹ entries is addressed only below 2³¹ (the gather's offsets are signed).
+    #[inline(always)]
+    fn gather(self, table: &[u32]) -> Self {
+        let inside = self.all_below(table.len().min(1 << 31) as u32);
+        assert!(
+            inside,
+            "a lane's index is outside the table of {} entries",
+            table.len()
+        );
+        // SAFETY: every index is below `table.len()` (tested above).
+        U32x8Avx2(unsafe { _mm256_i32gather_epi32::<4>(table.as_ptr() as *const i32, self.0) })
+    }
+    /// An unsigned minimum with `n − 1`, a compare and a byte mask.
+    #[inline(always)]
+    fn all_below(self, n: u32) -> bool {
+        n > 0
+            && unsafe {
+                let last = _mm256_set1_epi32((n - 1) as i32);
+                let kept = _mm256_cmpeq_epi32(_mm256_min_epu32(self.0, last), self.0);
+                _mm256_movemask_epi8(kept) == -1
+            }
+    }
     /// The top 24 bits (f32) or all 32 bits (f64) of each lane as a fraction in [0, 1): one
     /// shift and one conversion for f32 lanes (the shifted value is below 2²⁴, exact).
     #[inline(always)]
@@ -562,6 +586,39 @@ mod tests {
             );
             let f64s: [f64; 8] = std::array::from_fn(|i| a.unit::<crate::lanes::F64x8>().0[i]);
             assert_eq!(f64s, p.unit::<crate::lanes::F64x8>().0);
+        }
+    }
+
+    /// The integer gather reads each lane's entry, the array lanes' and one `u32`'s, and an
+    /// index outside the table (by one, with the sign bit, in an empty table) panics
+    /// before anything is read.
+    #[test]
+    fn register_integer_gather_reads_each_lanes_entry() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let table: Vec<u32> = (0..300u32).map(|k| k.wrapping_mul(0x9e37_79b9)).collect();
+        for idx in [[0, 299, 1, 298, 150, 7, 7, 0], [5, 6, 7, 8, 9, 10, 11, 12]] {
+            let a = U32x8(idx).gather(&table);
+            let p = U32x8Avx2::from_array(idx).gather(&table);
+            assert_eq!(a.0, p.to_array());
+            for i in 0..8 {
+                assert_eq!(a.0[i], table[idx[i] as usize]);
+                assert_eq!(idx[i].gather(&table), a.0[i]);
+            }
+        }
+        let seven = U32x8Avx2::from_array([0, 1, 2, 3, 4, 5, 6, 7]);
+        assert!(seven.all_below(8) && !seven.all_below(7) && !seven.all_below(0));
+        for (bad, len) in [(300, 300), (1 << 31, 300), (u32::MAX, 300), (0, 0)] {
+            let idx = U32x8Avx2::from_array([0, 1, 2, bad, 4, 5, 6, 7]);
+            let array = U32x8([0, 1, 2, bad, 4, 5, 6, 7]);
+            assert!(!idx.all_below(len as u32) && !array.all_below(len as u32));
+            let out = std::panic::catch_unwind(|| idx.gather(&table[..len]));
+            assert!(
+                out.is_err(),
+                "index {bad} of a table of {len} must not be read"
+            );
         }
     }
 

@@ -23,6 +23,11 @@ pub trait Bits32:
     fn shr(self, n: u32) -> Self;
     /// `self >> n[i]` lane by lane (each n < 32).
     fn shr_lanes(self, n: Self) -> Self;
+    /// `table[self[i]]` in each lane (a table look-up per lane); panics where an index is
+    /// outside the table.
+    fn gather(self, table: &[u32]) -> Self;
+    /// Whether every lane is below `n`.
+    fn all_below(self, n: u32) -> bool;
 
     /// The bits in reverse order: five swaps of ever smaller fields (the branch-free
     /// reversal, which vectorizes; `u32::reverse_bits` is one instruction only on ARM).
@@ -87,6 +92,14 @@ impl Bits32 for u32 {
     fn shr_lanes(self, n: Self) -> Self {
         self >> n
     }
+    #[inline(always)]
+    fn gather(self, table: &[u32]) -> Self {
+        table[self as usize]
+    }
+    #[inline(always)]
+    fn all_below(self, n: u32) -> bool {
+        self < n
+    }
 }
 
 /// Eight u32 lanes.
@@ -146,6 +159,14 @@ impl Bits32 for U32x8 {
     #[inline(always)]
     fn shr_lanes(self, n: Self) -> Self {
         U32x8(std::array::from_fn(|i| self.0[i] >> (n.0[i] & 31)))
+    }
+    #[inline(always)]
+    fn gather(self, table: &[u32]) -> Self {
+        U32x8(std::array::from_fn(|i| table[self.0[i] as usize]))
+    }
+    #[inline(always)]
+    fn all_below(self, n: u32) -> bool {
+        self.0.iter().all(|&v| v < n)
     }
 }
 

@@ -508,7 +508,9 @@ impl<'s> Kernel<'s> {
             paths.samples.copy_lane(i, &batch.samples, j);
             paths.o.set_lane(i, batch.o.lane(j));
             paths.d.set_lane(i, batch.d.lane(j));
-            paths.rd[i] = batch.rd[j];
+            if self.cameras.footprints {
+                paths.rd[i] = batch.rd[j];
+            }
             filled |= 1 << i;
         }
         if filled == 0 {
@@ -539,17 +541,12 @@ impl<'s> Kernel<'s> {
         batch: &mut CameraBatch<G>,
         jobs: &mut Jobs,
     ) -> bool {
-        let mut px = [0.0; LANES];
-        let mut py = [0.0; LANES];
+        let (mut xs, mut ys, mut ss) = ([0; LANES], [0; LANES], [0; LANES]);
         let mut n = 0;
         for (x, y, s, slot) in jobs.by_ref().take(LANES) {
             batch.streams.assign(n, (x, y, s as u64));
-            batch
-                .samples
-                .set_words(n, self.sampler.lane_words_at(x, y, s as u64));
+            (xs[n], ys[n], ss[n]) = (x, y, s as u64);
             batch.slot[n] = slot;
-            px[n] = x as f64 + 0.5;
-            py[n] = y as f64 + 0.5;
             n += 1;
         }
         batch.count = n;
@@ -557,6 +554,7 @@ impl<'s> Kernel<'s> {
         if n == 0 {
             return false;
         }
+        batch.samples = self.sampler.lane_words_batch::<S::Bits>(&xs, &ys, &ss, n);
         let active: Lanes = ((1u32 << n) - 1) as Lanes;
         // Samples without a lane form read every number from their streams: made now.
         batch
@@ -572,8 +570,8 @@ impl<'s> Kernel<'s> {
             true,
         );
         let (ox, oy) = scene.film.filter.sample_lanes(u0, u1);
-        let fx = G::from_fn(|i| px[i]) + conv(ox);
-        let fy = G::from_fn(|i| py[i]) + conv(oy);
+        let fx = G::from_fn(|i| xs[i] as f64 + 0.5) + conv(ox);
+        let fy = G::from_fn(|i| ys[i] as f64 + 0.5) + conv(oy);
         let lens = if scene.camera.has_lens() {
             let (l0, l1) = self.sampler.get_lanes::<S, S::Bits>(
                 &batch.samples,
@@ -668,7 +666,32 @@ impl<'s> Kernel<'s> {
         let mut first_model: Option<&LaneBsdf> = None;
         let mut smooth: Lanes = 0;
         let mut no_bsdf: Lanes = 0;
-        for i in lanes_of(paths.live) {
+        // Most vertices' lanes share one untextured lane material (a single object, or
+        // paths in step): its lanes are set at once.
+        let live = paths.live;
+        let material_of = |i: usize| scene.shape_material[hl.shape[i] as usize];
+        let shared = material_of(live.trailing_zeros() as usize);
+        let shared_lane = match &scene.materials[shared as usize] {
+            m if m.is_textured() => None,
+            m => m.lane_bsdf(),
+        };
+        let per_lane = match shared_lane {
+            Some(lane) if lanes_of(live).all(|i| material_of(i) == shared) => {
+                for i in lanes_of(live) {
+                    vertex.bsdfs[i] = VertexBsdf::Lane(lane);
+                }
+                lane_models = live;
+                if lane.reads_lobe_number() {
+                    reads_lobe = live;
+                }
+                if lane.flags().has_smooth_part() {
+                    smooth = live;
+                }
+                0
+            }
+            _ => live,
+        };
+        for i in lanes_of(per_lane) {
             let material = scene.shape_material[hl.shape[i] as usize] as usize;
             let m = &scene.materials[material];
             vertex.bsdfs[i] = match m.lane_bsdf() {

@@ -37,7 +37,7 @@ pub use prefixed_source::PrefixedSource;
 
 use facette_bsdf::math::rng::{mix_seed, Pcg32};
 use glam::DVec2;
-use sobol::{DimSeeds, ZSobol, ZSobolSample};
+use sobol::{ZSobol, ZSobolSample};
 use stratified::{Strata, StrataSample};
 
 /// Which sampler a render uses.
@@ -97,7 +97,7 @@ pub struct PixelSampler {
     /// Sobol with an index of at most 32 bits: each dimension's seeds under the render's
     /// common key, for the first [`lanes::TABULATED_DIMENSIONS`] dimensions (the render
     /// kernel's lanes read them; empty otherwise).
-    dim_seeds: Vec<DimSeeds>,
+    dim_seeds: lanes::SeedTable,
 }
 
 /// Domain separation of the independent sampler's per-sample key (an arbitrary odd
@@ -130,10 +130,8 @@ impl PixelSampler {
             SamplerKind::Stratified => Layout::Stratified(Strata::new(seed, spp)),
         };
         let dim_seeds = match &layout {
-            Layout::Sobol(z) if z.index_bits() <= 32 => (0..lanes::TABULATED_DIMENSIONS)
-                .map(|d| DimSeeds::new(z.common_key(), d))
-                .collect(),
-            _ => Vec::new(),
+            Layout::Sobol(z) if z.index_bits() <= 32 => lanes::SeedTable::new(z.common_key()),
+            _ => lanes::SeedTable::default(),
         };
         PixelSampler {
             kind,

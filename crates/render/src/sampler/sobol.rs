@@ -361,6 +361,50 @@ impl ZSobol {
         Some(self.reversed(index))
     }
 
+    /// [`lane_word_at`](Self::lane_word_at) of the samples `(xs[i], ys[i], samples[i])`, i <
+    /// `n`, in the integer lanes `B` (lanes from `n` on hold 0), where the layout alone
+    /// gives each of them its lane form: an index of at most 32 bits and every sample
+    /// number within the spp. `None` otherwise (ask lane by lane).
+    ///
+    /// An index of at most 32 bits leaves no pixel level to the tile hash (2·levels ≤ 32 −
+    /// log2_spp keeps `levels` at the image's, see [`ZSobol::new`]): every pixel is in tile
+    /// (0, 0), its coordinates are below 2^16, and a sample number below 2^log2_spp has no
+    /// extra part, so the key is the common one. Then the word is the Morton code and the
+    /// sample number, reversed: about 25 vector instructions for eight camera samples
+    /// against about 120 scalar ones a sample.
+    #[inline(always)]
+    pub(crate) fn lane_words<B: Bits32>(
+        &self,
+        xs: &[usize; 8],
+        ys: &[usize; 8],
+        samples: &[u64; 8],
+        n: usize,
+    ) -> Option<B> {
+        let bits = self.index_bits();
+        if bits > 32 || samples[..n].iter().any(|&s| s >> self.log2_spp != 0) {
+            return None;
+        }
+        if bits == 0 {
+            return Some(B::splat(0));
+        }
+        // Bit k of a 16-bit value to bit 2k.
+        let spread = |v: B| {
+            let v = (v | v.shl(8)) & B::splat(0x00ff_00ff);
+            let v = (v | v.shl(4)) & B::splat(0x0f0f_0f0f);
+            let v = (v | v.shl(2)) & B::splat(0x3333_3333);
+            (v | v.shl(1)) & B::splat(0x5555_5555)
+        };
+        let lanes = |a: &[usize; 8]| B::from_fn(|i| if i < n { a[i] as u32 } else { 0 });
+        let s = B::from_fn(|i| if i < n { samples[i] as u32 } else { 0 });
+        // log2_spp ≤ bits ≤ 32; at 32 there is no pixel level (and no shift by 32).
+        let index = if self.log2_spp >= 32 {
+            s
+        } else {
+            (spread(lanes(xs)) | spread(lanes(ys)).shl(1)).shl(self.log2_spp) | s
+        };
+        Some(index.shl(32 - bits).reverse())
+    }
+
     /// The key of every sample when the index has at most 32 bits (one tile) and the sample
     /// number is within the render's spp: what the render kernel's per-dimension table of
     /// [`DimSeeds`] is built from.
