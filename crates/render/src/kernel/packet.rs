@@ -383,11 +383,14 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         eta_scale: S::one(),
         segment: U32x8::splat(1),
     };
+    let lane_materials = job.scene.materials.iter().filter_map(|m| m.lane_bsdf());
     let k = Kernel {
         scene: job.scene,
         sampler: job.sampler,
         cameras: job.cameras,
         strategy: job.strategy,
+        lane_materials: lane_materials.clone().next().is_some(),
+        lobe_numbers: lane_materials.clone().any(|m| m.reads_lobe_number()),
     };
     loop {
         k.refill(&mut paths, &mut batch, &mut jobs);
@@ -406,6 +409,19 @@ struct Kernel<'a> {
     sampler: &'a PixelSampler,
     cameras: CameraSampling,
     strategy: Strategy,
+    /// Whether some material has a lane model, and whether one of them reads a lobe
+    /// number: which of a vertex's numbers [`Kernel::vertex_numbers`] draws ahead.
+    lane_materials: bool,
+    lobe_numbers: bool,
+}
+
+/// A vertex's numbers drawn ahead, at the start of its segment, for every live lane
+/// ([`Kernel::vertex_numbers`]); `None` where not drawn ahead (then drawn where used).
+struct VertexNumbers<S> {
+    select: Option<S>,
+    light: Option<(S, S)>,
+    lobe: Option<S>,
+    bsdf: Option<(S, S)>,
 }
 
 /// The materials of a vertex: each lane's, the lanes whose material is a lane model and
@@ -637,6 +653,12 @@ impl<'s> Kernel<'s> {
         sums: &mut [PixelSums],
     ) {
         let scene = self.scene;
+        let block = paths
+            .segment
+            .wrapping_add(U32x8::splat(u32::MAX))
+            .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
+            .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
+        let numbers = self.vertex_numbers(paths, block);
         let rays = LaneRays::new(paths.o, paths.d, G::splat(f64::INFINITY), paths.live);
         let (hit_set, hit_t) = scene.geometry.intersect_lanes(&rays, &mut segment.hits);
         let missed = paths.live & !hit_set;
@@ -757,15 +779,71 @@ impl<'s> Kernel<'s> {
         let vertex = &segment.vertex;
         let frame = LFrame::from_normal_tangent(hl.ns, hl.dpdu);
         let wo = conv_vec::<G, S>(frame.to_local(-paths.d));
-        let block = paths
-            .segment
-            .wrapping_add(U32x8::splat(u32::MAX))
-            .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
-            .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
         if self.strategy != Strategy::BsdfOnly {
-            self.next_event(paths, hl, &frame, wo, vertex, smooth & paths.live, block);
+            let set = smooth & paths.live;
+            self.next_event(paths, hl, &frame, wo, vertex, set, block, &numbers);
         }
-        self.continue_paths(paths, hl, &frame, wo, vertex, block, sums);
+        self.continue_paths(paths, hl, &frame, wo, vertex, block, &numbers, sums);
+    }
+
+    /// The numbers of the vertex at the end of this segment that every lane with a lane
+    /// material draws (light selection and position, lobe, direction; not the roulette's,
+    /// drawn from depth 5 on), drawn for every live lane before the ray query: they depend
+    /// only on the lane's sample and the vertex's dimension block, and their hash chains
+    /// (Sobol: four dependent 10-cycle `vpmulld`s a scramble) then run beside the query's
+    /// floating-point work instead of stalling the shading that reads them. Lanes that miss,
+    /// or do not read a number, leave it unused; draws have no state (each names its
+    /// dimension), so the values are those drawn where they are used.
+    #[inline(always)]
+    fn vertex_numbers<S: ShadingLanes, G: Real>(
+        &self,
+        paths: &mut Paths<S, G>,
+        block: U32x8,
+    ) -> VertexNumbers<S> {
+        // No closures here: a closure is compiled with its defining function's instruction
+        // set, and this one is generic, without the AVX2 build's (see `lanes::channels`).
+        let selector = &self.scene.selector;
+        let nee = self.strategy != Strategy::BsdfOnly;
+        VertexNumbers {
+            select: if nee && selector.reads_selection_number() {
+                Some(self.draw(paths, block, 0, false).0)
+            } else {
+                None
+            },
+            light: if nee && selector.reads_position_numbers() {
+                Some(self.draw(paths, block, 1, true))
+            } else {
+                None
+            },
+            lobe: if self.lobe_numbers {
+                Some(self.draw(paths, block, 3, false).0)
+            } else {
+                None
+            },
+            bsdf: if self.lane_materials {
+                Some(self.draw(paths, block, 4, true))
+            } else {
+                None
+            },
+        }
+    }
+
+    /// Every live lane's number of dimension `block + offset` (and the next where `pair`).
+    #[inline(always)]
+    fn draw<S: ShadingLanes, G: Real>(
+        &self,
+        paths: &mut Paths<S, G>,
+        block: U32x8,
+        offset: u32,
+        pair: bool,
+    ) -> (S, S) {
+        self.sampler.get_lanes::<S, S::Bits>(
+            &paths.samples,
+            paths.streams.all(),
+            block.wrapping_add(U32x8::splat(offset)),
+            paths.live,
+            pair,
+        )
     }
 
     /// Lane `i`'s texture coordinates and footprint where its material `m` reads them (what
@@ -876,29 +954,32 @@ impl<'s> Kernel<'s> {
         vertex: &VertexMaterials,
         set: Lanes,
         block: U32x8,
+        numbers: &VertexNumbers<S>,
     ) {
         if set == 0 {
             return;
         }
         let scene = self.scene;
         let selector = &scene.selector;
-        let u_select = if selector.reads_selection_number() {
-            self.sampler
-                .get_lanes::<S, S::Bits>(&paths.samples, paths.streams.all(), block, set, false)
-                .0
-        } else {
-            S::splat(0.5)
+        let u_select = match numbers.select {
+            Some(u) => u,
+            None if selector.reads_selection_number() => {
+                self.sampler
+                    .get_lanes::<S, S::Bits>(&paths.samples, paths.streams.all(), block, set, false)
+                    .0
+            }
+            None => S::splat(0.5),
         };
-        let (u0, u1) = if selector.reads_position_numbers() {
-            self.sampler.get_lanes::<S, S::Bits>(
+        let (u0, u1) = match numbers.light {
+            Some(u) => u,
+            None if selector.reads_position_numbers() => self.sampler.get_lanes::<S, S::Bits>(
                 &paths.samples,
                 paths.streams.all(),
                 block.wrapping_add(U32x8::splat(1)),
                 set,
                 true,
-            )
-        } else {
-            (S::splat(0.5), S::splat(0.5))
+            ),
+            None => (S::splat(0.5), S::splat(0.5)),
         };
         // The light of each lane.
         let mut light_of = [usize::MAX; LANES];
@@ -1105,6 +1186,7 @@ impl<'s> Kernel<'s> {
         wo: LVec3<S>,
         vertex: &VertexMaterials,
         block: U32x8,
+        numbers: &VertexNumbers<S>,
         sums: &mut [PixelSums],
     ) {
         let live = paths.live;
@@ -1119,26 +1201,31 @@ impl<'s> Kernel<'s> {
         let lane_set = vertex.lane_models & live;
         if lane_set != 0 {
             let lobe_set = vertex.reads_lobe & live;
-            let u_lobe = if lobe_set != 0 {
-                self.sampler
-                    .get_lanes::<S, S::Bits>(
-                        &paths.samples,
-                        paths.streams.all(),
-                        block.wrapping_add(U32x8::splat(3)),
-                        lobe_set,
-                        false,
-                    )
-                    .0
-            } else {
-                S::splat(0.5)
+            let u_lobe = match numbers.lobe {
+                Some(u) => u,
+                None if lobe_set != 0 => {
+                    self.sampler
+                        .get_lanes::<S, S::Bits>(
+                            &paths.samples,
+                            paths.streams.all(),
+                            block.wrapping_add(U32x8::splat(3)),
+                            lobe_set,
+                            false,
+                        )
+                        .0
+                }
+                None => S::splat(0.5),
             };
-            let (u0, u1) = self.sampler.get_lanes::<S, S::Bits>(
-                &paths.samples,
-                paths.streams.all(),
-                block.wrapping_add(U32x8::splat(4)),
-                lane_set,
-                true,
-            );
+            let (u0, u1) = match numbers.bsdf {
+                Some(u) => u,
+                None => self.sampler.get_lanes::<S, S::Bits>(
+                    &paths.samples,
+                    paths.streams.all(),
+                    block.wrapping_add(U32x8::splat(4)),
+                    lane_set,
+                    true,
+                ),
+            };
             let mut todo = lane_set;
             while let Some((model, group, textured)) = vertex.lane_group(todo) {
                 todo &= !group;

@@ -387,13 +387,15 @@ impl ZSobol {
         if bits == 0 {
             return Some(B::splat(0));
         }
-        // Bit k of a 16-bit value to bit 2k.
-        let spread = |v: B| {
+        // Bit k of a 16-bit value to bit 2k. A function, not a closure: a closure is
+        // compiled with this generic function's instruction set, not the AVX2 kernel's.
+        #[inline(always)]
+        fn spread<B: Bits32>(v: B) -> B {
             let v = (v | v.shl(8)) & B::splat(0x00ff_00ff);
             let v = (v | v.shl(4)) & B::splat(0x0f0f_0f0f);
             let v = (v | v.shl(2)) & B::splat(0x3333_3333);
             (v | v.shl(1)) & B::splat(0x5555_5555)
-        };
+        }
         let lanes = |a: &[usize; 8]| B::from_fn(|i| if i < n { a[i] as u32 } else { 0 });
         let s = B::from_fn(|i| if i < n { samples[i] as u32 } else { 0 });
         // log2_spp ≤ bits ≤ 32; at 32 there is no pixel level (and no shift by 32).
