@@ -231,13 +231,22 @@ impl Transform {
     /// [`point`](Self::point) over lanes, with glam's order of operations.
     #[inline(always)]
     pub fn point_lanes<R: Real>(&self, p: LVec3<R>) -> LVec3<R> {
+        // Functions, not closures or `array::from_fn`: those are compiled apart, with the
+        // instruction set of this generic code rather than the AVX2 kernel's, and called
+        // out of line where LLVM does not inline them (it had stopped doing so here).
+        #[inline(always)]
+        fn row<R: Real>(m: &Mat4, k: usize, p: LVec3<R>) -> R {
+            let (x, y, z, w) = (m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]);
+            ((R::splat(x) * p.x + R::splat(y) * p.y) + R::splat(z) * p.z) + R::splat(w)
+        }
         let m = &self.m;
-        let c = |a: DVec4| [R::splat(a.x), R::splat(a.y), R::splat(a.z), R::splat(a.w)];
-        let (x, y, z, w) = (c(m.x_axis), c(m.y_axis), c(m.z_axis), c(m.w_axis));
-        let h: [R; 4] = std::array::from_fn(|k| ((x[k] * p.x + y[k] * p.y) + z[k] * p.z) + w[k]);
+        let h = [row(m, 0, p), row(m, 1, p), row(m, 2, p), row(m, 3, p)];
         let affine = h[3].eq(R::one());
-        let div = |v: R| R::select(affine, v, v / h[3]);
-        LVec3::new(div(h[0]), div(h[1]), div(h[2]))
+        LVec3::new(
+            R::select(affine, h[0], h[0] / h[3]),
+            R::select(affine, h[1], h[1] / h[3]),
+            R::select(affine, h[2], h[2] / h[3]),
+        )
     }
 
     /// [`inverse_vector`](Self::inverse_vector) over lanes.
