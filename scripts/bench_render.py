@@ -448,6 +448,23 @@ def markdown(rows, args, info):
     return "\n".join(lines) + "\n"
 
 
+def out_of_line_intrinsics(binary):
+    """Calls of `core::arch` intrinsics in `binary` (objdump), or None without objdump.
+
+    The AVX2 kernel's register lanes are only fast inlined: a closure or a std helper such
+    as `array::from_fn` in generic code is compiled with that code's instruction set, not
+    the kernel's, and its lane operations become calls (docs/performance.md, 2026-12-05).
+    A healthy build has one: the CPU feature test's `xgetbv`.
+    """
+    try:
+        asm = subprocess.run(["objdump", "-d", "--no-show-raw-insn", binary],
+                             capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return sorted({m for m in re.findall(r"call\s+\S+\s+<([^>]*core_arch[^>]*)>", asm)
+                   if "xgetbv" not in m})
+
+
 def main():
     global FACETTE
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -475,6 +492,15 @@ def main():
         sys.exit(f"error: {FACETTE} not found: cargo build --release -p facette")
     if args.spp < 1 or args.repeats < 1:
         sys.exit("error: --spp and --repeats must be at least 1")
+    calls = out_of_line_intrinsics(FACETTE)
+    if calls is None:
+        print("note: no objdump: the binary's inlining of the lane intrinsics is not checked")
+    elif calls:
+        bar = "!" * 78
+        print(f"{bar}\nWARNING: {FACETTE} calls {len(calls)} distinct lane intrinsic(s) out of line"
+              f" ({', '.join(calls[:4])}{', …' if len(calls) > 4 else ''}): a closure or std"
+              " helper in lane code\nwas compiled without AVX2 (docs/performance.md). Its"
+              f" timings are not the kernel's.\n{bar}", file=sys.stderr)
     names = args.only or (
         list(SCENES) + (["showcase"] if args.showcase else []) + (["mesh"] if args.mesh else [])
     )
