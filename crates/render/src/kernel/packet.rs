@@ -410,29 +410,28 @@ struct Kernel<'a> {
     cameras: CameraSampling,
     strategy: Strategy,
     /// Whether some material has a lane model, and whether one of them reads a lobe
-    /// number: which of a vertex's numbers [`Kernel::vertex_numbers`] draws ahead.
+    /// number (a textured roughness keeps its material's model kind): which of a vertex's
+    /// numbers [`Kernel::vertex_numbers`] draws.
     lane_materials: bool,
     lobe_numbers: bool,
 }
 
 /// A vertex's numbers drawn ahead, at the start of its segment, for every live lane
-/// ([`Kernel::vertex_numbers`]); `None` where not drawn ahead (then drawn where used).
+/// ([`Kernel::vertex_numbers`]); ½ where nobody reads them.
 struct VertexNumbers<S> {
-    select: Option<S>,
-    light: Option<(S, S)>,
-    lobe: Option<S>,
-    bsdf: Option<(S, S)>,
+    select: S,
+    light: (S, S),
+    lobe: S,
+    bsdf: (S, S),
 }
 
-/// The materials of a vertex: each lane's, the lanes whose material is a lane model and
-/// those among them whose model reads a lobe number, and whether those lanes share one
-/// model (then a model's group is found without comparing lanes) — found once, where the
+/// The materials of a vertex: each lane's, the lanes whose material is a lane model, and
+/// whether those lanes share one model (then a model's group is found without comparing lanes) — found once, where the
 /// materials are looked up.
 struct VertexMaterials<'s> {
     /// The live lanes' materials (the other lanes' are left from earlier vertices).
     bsdfs: [VertexBsdf<'s>; LANES],
     lane_models: Lanes,
-    reads_lobe: Lanes,
     one_lane_model: bool,
     /// The lanes of [`VertexBsdf::Lane`] whose colors are textured.
     textured: Lanes,
@@ -444,7 +443,6 @@ impl Default for VertexMaterials<'_> {
         VertexMaterials {
             bsdfs: std::array::from_fn(|_| VertexBsdf::None),
             lane_models: 0,
-            reads_lobe: 0,
             one_lane_model: true,
             textured: 0,
             texels: LaneTexels::default(),
@@ -683,7 +681,7 @@ impl<'s> Kernel<'s> {
         }
         // The materials.
         let vertex = &mut segment.vertex;
-        let (mut lane_models, mut reads_lobe, mut textured): (Lanes, Lanes, Lanes) = (0, 0, 0);
+        let (mut lane_models, mut textured): (Lanes, Lanes) = (0, 0);
         let mut one_lane_model = true;
         let mut first_model: Option<&LaneBsdf> = None;
         let mut smooth: Lanes = 0;
@@ -703,9 +701,6 @@ impl<'s> Kernel<'s> {
                     vertex.bsdfs[i] = VertexBsdf::Lane(lane);
                 }
                 lane_models = live;
-                if lane.reads_lobe_number() {
-                    reads_lobe = live;
-                }
                 if lane.flags().has_smooth_part() {
                     smooth = live;
                 }
@@ -740,9 +735,6 @@ impl<'s> Kernel<'s> {
                         VertexBsdf::Lane(lane)
                     };
                     lane_models |= 1 << i;
-                    if lane.reads_lobe_number() {
-                        reads_lobe |= 1 << i;
-                    }
                     match first_model {
                         None => first_model = Some(lane),
                         Some(f) => one_lane_model &= std::ptr::eq(f, lane),
@@ -773,7 +765,6 @@ impl<'s> Kernel<'s> {
             Self::finish(paths, no_bsdf, sums);
         }
         vertex.lane_models = lane_models;
-        vertex.reads_lobe = reads_lobe;
         vertex.one_lane_model = one_lane_model;
         vertex.textured = textured;
         let vertex = &segment.vertex;
@@ -781,7 +772,7 @@ impl<'s> Kernel<'s> {
         let wo = conv_vec::<G, S>(frame.to_local(-paths.d));
         if self.strategy != Strategy::BsdfOnly {
             let set = smooth & paths.live;
-            self.next_event(paths, hl, &frame, wo, vertex, set, block, &numbers);
+            self.next_event(paths, hl, &frame, wo, vertex, set, &numbers);
         }
         self.continue_paths(paths, hl, &frame, wo, vertex, block, &numbers, sums);
     }
@@ -802,46 +793,49 @@ impl<'s> Kernel<'s> {
     ) -> VertexNumbers<S> {
         // No closures here: a closure is compiled with its defining function's instruction
         // set, and this one is generic, without the AVX2 build's (see `lanes::channels`).
-        let selector = &self.scene.selector;
+        let (selector, live) = (&self.scene.selector, paths.live);
         let nee = self.strategy != Strategy::BsdfOnly;
+        let half = (S::splat(0.5), S::splat(0.5));
         VertexNumbers {
             select: if nee && selector.reads_selection_number() {
-                Some(self.draw(paths, block, 0, false).0)
+                self.draw(paths, block, 0, live, false).0
             } else {
-                None
+                half.0
             },
             light: if nee && selector.reads_position_numbers() {
-                Some(self.draw(paths, block, 1, true))
+                self.draw(paths, block, 1, live, true)
             } else {
-                None
+                half
             },
             lobe: if self.lobe_numbers {
-                Some(self.draw(paths, block, 3, false).0)
+                self.draw(paths, block, 3, live, false).0
             } else {
-                None
+                half.0
             },
             bsdf: if self.lane_materials {
-                Some(self.draw(paths, block, 4, true))
+                self.draw(paths, block, 4, live, true)
             } else {
-                None
+                half
             },
         }
     }
 
-    /// Every live lane's number of dimension `block + offset` (and the next where `pair`).
+    /// The number of dimension `block + offset` (and the next where `pair`) of each lane
+    /// of `set` (the others hold ½).
     #[inline(always)]
     fn draw<S: ShadingLanes, G: Real>(
         &self,
         paths: &mut Paths<S, G>,
         block: U32x8,
         offset: u32,
+        set: Lanes,
         pair: bool,
     ) -> (S, S) {
         self.sampler.get_lanes::<S, S::Bits>(
             &paths.samples,
             paths.streams.all(),
             block.wrapping_add(U32x8::splat(offset)),
-            paths.live,
+            set,
             pair,
         )
     }
@@ -953,7 +947,6 @@ impl<'s> Kernel<'s> {
         wo: LVec3<S>,
         vertex: &VertexMaterials,
         set: Lanes,
-        block: U32x8,
         numbers: &VertexNumbers<S>,
     ) {
         if set == 0 {
@@ -961,26 +954,8 @@ impl<'s> Kernel<'s> {
         }
         let scene = self.scene;
         let selector = &scene.selector;
-        let u_select = match numbers.select {
-            Some(u) => u,
-            None if selector.reads_selection_number() => {
-                self.sampler
-                    .get_lanes::<S, S::Bits>(&paths.samples, paths.streams.all(), block, set, false)
-                    .0
-            }
-            None => S::splat(0.5),
-        };
-        let (u0, u1) = match numbers.light {
-            Some(u) => u,
-            None if selector.reads_position_numbers() => self.sampler.get_lanes::<S, S::Bits>(
-                &paths.samples,
-                paths.streams.all(),
-                block.wrapping_add(U32x8::splat(1)),
-                set,
-                true,
-            ),
-            None => (S::splat(0.5), S::splat(0.5)),
-        };
+        let u_select = numbers.select;
+        let (u0, u1) = numbers.light;
         // The light of each lane.
         let mut light_of = [usize::MAX; LANES];
         let mut p_select = [0.0; LANES];
@@ -1200,32 +1175,8 @@ impl<'s> Kernel<'s> {
         // Lane models: the lobe number where a model reads it, the direction pair.
         let lane_set = vertex.lane_models & live;
         if lane_set != 0 {
-            let lobe_set = vertex.reads_lobe & live;
-            let u_lobe = match numbers.lobe {
-                Some(u) => u,
-                None if lobe_set != 0 => {
-                    self.sampler
-                        .get_lanes::<S, S::Bits>(
-                            &paths.samples,
-                            paths.streams.all(),
-                            block.wrapping_add(U32x8::splat(3)),
-                            lobe_set,
-                            false,
-                        )
-                        .0
-                }
-                None => S::splat(0.5),
-            };
-            let (u0, u1) = match numbers.bsdf {
-                Some(u) => u,
-                None => self.sampler.get_lanes::<S, S::Bits>(
-                    &paths.samples,
-                    paths.streams.all(),
-                    block.wrapping_add(U32x8::splat(4)),
-                    lane_set,
-                    true,
-                ),
-            };
+            let u_lobe = numbers.lobe;
+            let (u0, u1) = numbers.bsdf;
             let mut todo = lane_set;
             while let Some((model, group, textured)) = vertex.lane_group(todo) {
                 todo &= !group;
@@ -1302,16 +1253,7 @@ impl<'s> Kernel<'s> {
         if rr != 0 {
             let q = paths.beta[0].max(paths.beta[1]).max(paths.beta[2]) * paths.eta_scale;
             let q = q.min(S::splat(0.95));
-            let u = self
-                .sampler
-                .get_lanes::<S, S::Bits>(
-                    &paths.samples,
-                    paths.streams.all(),
-                    block.wrapping_add(U32x8::splat(6)),
-                    rr,
-                    false,
-                )
-                .0;
+            let u = self.draw(paths, block, 6, rr, false).0;
             let survive = set_of(q.gt(S::zero()) & u.lt(q));
             killed = rr & !survive;
             let kept = rr & survive;
