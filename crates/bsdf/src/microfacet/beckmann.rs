@@ -139,9 +139,12 @@ impl Beckmann {
 
     /// Exact G1 = 1/(1 + Λ) over lanes. In f64 the table lookup, per lane; in f32 lanes the
     /// closed form G1 = 2/(1 + erf(a) + e^{−a²}/(a√π)) [WMLT07 eq. 26] with a = z/r
-    /// (r = α_v sin θ), multiplied through by a√π: G1 = 2z√π/(z√π(2 − erfc a) + r e^{−a²}),
-    /// which vectorizes ([`erfc_lanes`]), is 1 at r = 0 and 0 at z = 0, and keeps an
-    /// absolute error of a few 1e-8 (the tests measure it against the table).
+    /// (r = α_v sin θ), multiplied through by a√π: G1 = 2z√π/(z√π(2 − erfc a) + r e^{−a²}).
+    /// erfc(a) = t p(t) e^{−a²} with t = 1/(1 + 0.3275911 a) and p of degree 4
+    /// [Abramowitz & Stegun 7.1.26, absolute error ≤ 1.5e-7] shares the one exponential:
+    /// G1 = 2z√π/(2z√π + e^{−a²}(r − z√π t p(t))). ∂G1/∂erfc = G1²/2, so the fit moves G1
+    /// by at most 7.5e-8; it is 1 at r = 0 (e^{−a²} = 0) and 0 at z = 0 (the tests measure
+    /// it against the table).
     #[inline(always)]
     pub fn g1_exact_lanes<R: Real>(&self, v: LVec3<R>) -> R {
         let s2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
@@ -152,8 +155,14 @@ impl Beckmann {
             (z / (z + r)).map(|y| table.eval(y))
         } else {
             let a = z / r;
+            let t = r / (r + R::splat(0.327_591_1) * z);
+            let mut p = R::splat(1.061_405_429);
+            for c in [-1.453_152_027, 1.421_413_741, -0.284_496_736, 0.254_829_592] {
+                p = p * t + R::splat(c);
+            }
             let zs = z * R::splat(SQRT_PI);
-            R::splat(2.0) * zs / (zs * (R::splat(2.0) - erfc_lanes(a)) + r * (-(a * a)).exp())
+            let e = (-(a * a)).exp();
+            R::splat(2.0) * zs / (R::splat(2.0) * zs + e * (r - zs * t * p))
         };
         R::select(s2.le(R::zero()), R::one(), g)
     }
@@ -171,14 +180,35 @@ impl Beckmann {
         R::select((z * z).ge(R::splat(2.56) * r2), R::one(), g)
     }
 
+    /// G1(v) in the model's form, without WMLT07 eq. 7's sidedness.
+    #[inline(always)]
+    pub fn g1_model_lanes<R: Real>(&self, v: LVec3<R>) -> R {
+        match self.g1_form {
+            BeckmannG1::Exact => self.g1_exact_lanes(v),
+            BeckmannG1::Rational => self.g1_rational_lanes(v),
+        }
+    }
+
+    /// G1(v) both ways a visible-normal sampler needs it, without the sidedness: the exact
+    /// G1 (its density's, [Heitz 2014, eq. 2]) and the model's G1 divided by it (the ratio
+    /// in the sample's weight). One exact evaluation where the model is exact (ratio 1).
+    #[inline(always)]
+    pub fn g1_visible_and_ratio_lanes<R: Real>(&self, v: LVec3<R>) -> (R, R) {
+        let exact = self.g1_exact_lanes(v);
+        match self.g1_form {
+            BeckmannG1::Exact => (exact, R::one()),
+            BeckmannG1::Rational => (exact, self.g1_rational_lanes(v) / exact),
+        }
+    }
+
     /// G1(v, m) in the model's form, 0 where v sees the back of m (WMLT07 eq. 7's χ⁺).
     #[inline(always)]
     pub fn g1_lanes<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
-        let g = match self.g1_form {
-            BeckmannG1::Exact => self.g1_exact_lanes(v),
-            BeckmannG1::Rational => self.g1_rational_lanes(v),
-        };
-        R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g)
+        R::select(
+            (v.dot(m) * v.z).le(R::zero()),
+            R::zero(),
+            self.g1_model_lanes(v),
+        )
     }
 
     /// D(m) = exp(−(x²/α_x² + y²/α_y²)/z²) / (π α_x α_y z⁴)  [IL18 eq. 16; WMLT07 eq. 25];

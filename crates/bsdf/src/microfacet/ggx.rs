@@ -106,10 +106,20 @@ impl Ggx {
     /// 0 where v sees the back of m (WMLT07 eq. 7's χ⁺).
     #[inline(always)]
     pub fn g1_lanes<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
+        R::select(
+            (v.dot(m) * v.z).le(R::zero()),
+            R::zero(),
+            self.g1_unsided_lanes(v),
+        )
+    }
+
+    /// [`g1_lanes`](Self::g1_lanes) without the sidedness: 2z / (z + √(z² + α_v² sin² θ))
+    /// = 1/(1 + Λ(v)) [WMLT07 eq. 34].
+    #[inline(always)]
+    pub fn g1_unsided_lanes<R: Real>(&self, v: LVec3<R>) -> R {
         let s2 = R::splat(self.ax2) * v.x * v.x + R::splat(self.ay2) * v.y * v.y;
         let z = v.z.abs();
-        let g = R::splat(2.0) * z / (z + (z * z + s2).sqrt());
-        R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g)
+        R::splat(2.0) * z / (z + (z * z + s2).sqrt())
     }
 
     /// D(m)|m·n| sampling over lanes, the one source of [`Distribution::sample_normal`].

@@ -65,29 +65,39 @@ impl LaneNdf {
         }
     }
 
-    /// The density of visible normals seen from v (v.z > 0): G1_v(v) (v·m) D(m) / v.z
-    /// [Heitz 2014, eq. 2]; G1_v is exact even where the model's G1 is a fit.
+    /// G1(v) without the sidedness, both ways a visible-normal sampler needs it: the exact
+    /// G1_v of the density [Heitz 2014, eq. 2] (exact even where the model's G1 is a fit),
+    /// and the model's G1 over it (1 where the model is exact). One evaluation of G1 serves
+    /// the density and the masking of the view's side, which the sample's weight
+    /// G(i, o, m)/G1_v(o) [Heitz 2014, eq. 19] reduces to for separable Smith masking.
     #[inline(always)]
-    fn pdf_visible<R: Real>(&self, v: LVec3<R>, m: LVec3<R>, d: R) -> R {
+    fn g1_visible_and_ratio<R: Real>(&self, v: LVec3<R>) -> (R, R) {
+        match self {
+            LaneNdf::Ggx(g) => (g.g1_unsided_lanes(v), R::one()),
+            LaneNdf::Beckmann(b) => b.g1_visible_and_ratio_lanes(v),
+        }
+    }
+
+    /// The model's G1(v) without the sidedness.
+    #[inline(always)]
+    fn g1_model<R: Real>(&self, v: LVec3<R>) -> R {
+        match self {
+            LaneNdf::Ggx(g) => g.g1_unsided_lanes(v),
+            LaneNdf::Beckmann(b) => b.g1_model_lanes(v),
+        }
+    }
+
+    /// The density of visible normals seen from v (v.z > 0): G1_v(v) (v·m) D(m) / v.z
+    /// [Heitz 2014, eq. 2], with `g1v` = G1_v(v) from
+    /// [`g1_visible_and_ratio`](Self::g1_visible_and_ratio).
+    #[inline(always)]
+    fn pdf_visible<R: Real>(v: LVec3<R>, m: LVec3<R>, d: R, g1v: R) -> R {
         let vm = v.dot(m);
-        let p = match self {
-            LaneNdf::Ggx(g) => vm * d / ((R::one() + g.lambda_lanes(v)) * v.z),
-            LaneNdf::Beckmann(b) => b.g1_exact_lanes(v) * vm * d / v.z,
-        };
         R::select(
             vm.le(R::zero()) | v.z.le(R::zero()) | d.eq(R::zero()),
             R::zero(),
-            p,
+            g1v * vm * d / v.z,
         )
-    }
-
-    /// G1_v(v) of [`pdf_visible`](Self::pdf_visible).
-    #[inline(always)]
-    fn g1_visible<R: Real>(&self, v: LVec3<R>) -> R {
-        match self {
-            LaneNdf::Ggx(g) => R::one() / (R::one() + g.lambda_lanes(v)),
-            LaneNdf::Beckmann(b) => b.g1_exact_lanes(v),
-        }
     }
 
     #[inline(always)]
@@ -112,6 +122,19 @@ impl LaneNdf {
     fn g<R: Real>(&self, i: LVec3<R>, o: LVec3<R>, m: LVec3<R>) -> R {
         self.g1(i, m) * self.g1(o, m)
     }
+
+    /// [`g`](Self::g) with o's unsided model G1 already known (`g1o`, from
+    /// [`g1_visible_and_ratio`](Self::g1_visible_and_ratio) as G1_v × ratio).
+    #[inline(always)]
+    fn g_with_o<R: Real>(&self, i: LVec3<R>, o: LVec3<R>, m: LVec3<R>, g1o: R) -> R {
+        sided(i, m, self.g1_model(i)) * sided(o, m, g1o)
+    }
+}
+
+/// `g1` (an unsided G1 of v) where v sees the front of m, else 0 (WMLT07 eq. 7's χ⁺).
+#[inline(always)]
+fn sided<R: Real>(v: LVec3<R>, m: LVec3<R>, g1: R) -> R {
+    R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g1)
 }
 
 /// A conductor's Fresnel term over lanes.
@@ -336,8 +359,9 @@ impl LaneBsdf {
                 let cos_oh = o.dot(h);
                 let ok = (wo.z * wi.z).gt(R::zero()) & h.z.gt(R::zero()) & cos_oh.gt(R::zero());
                 let d = ndf.d(h);
-                let geom = d * ndf.g(i, o, h) / (R::splat(4.0) * o.z * i.z);
-                let pdf = ndf.pdf_visible(o, h, d) / (R::splat(4.0) * cos_oh);
+                let (g1v, ratio) = ndf.g1_visible_and_ratio(o);
+                let geom = d * ndf.g_with_o(i, o, h, g1v * ratio) / (R::splat(4.0) * o.z * i.z);
+                let pdf = LaneNdf::pdf_visible(o, h, d, g1v) / (R::splat(4.0) * cos_oh);
                 let f = fresnel.eval(cos_oh);
                 let ok = ok & geom.gt(R::zero());
                 let v = channels(|c| R::masked(ok, tint[c] * f[c] * geom));
@@ -367,7 +391,8 @@ impl LaneBsdf {
                 let (o, i) = (mirror(wo, s), mirror(wi, s));
                 let same = (wo.z * wi.z).gt(R::zero());
                 let ps = colors.specular_probability(*specular_probability);
-                let (spec, pdf) = Self::il_specular(ndf, *ni, ps, o, i);
+                let (spec, pdf) =
+                    Self::il_specular(ndf, *ni, ps, o, i, ndf.g1_visible_and_ratio(o));
                 let (u0, u1) = rng.next_2d(same);
                 let b = Self::il_body(ndf, *ni, o, i, u0, u1);
                 let body = colors.tint(body);
@@ -401,7 +426,10 @@ impl LaneBsdf {
             & !wo.z.eq(zero)
             & !wi.z.eq(zero);
         let d = ndf.d(h);
-        let g = ndf.g(wi, wo, h);
+        // G1 of wo serves the masking and the density (seen from ±wo: G1 is even in z).
+        let up = wo.scale(wo.z.sign_or_one());
+        let (g1v, ratio) = ndf.g1_visible_and_ratio(up);
+        let g = ndf.g_with_o(wi, wo, h, g1v * ratio);
         // One Fresnel term, seen from wo's side (the same from wi's for a refraction pair).
         let n_t = R::select(wo.z.gt(zero), R::splat(eta), R::one());
         let f = fresnel_dielectric_lanes(oh.abs(), n_t / n_o);
@@ -412,8 +440,7 @@ impl LaneBsdf {
         let ft =
             (ih * oh).abs() / cos_io * n_o * n_o * (R::one() - f) * g * d / (denom_e * denom_e);
         // Densities from wo: WMLT07 eqs. 14 and 17 with visible normals seen from ±wo.
-        let up = wo.scale(wo.z.sign_or_one());
-        let pm = ndf.pdf_visible(up, h, d);
+        let pm = LaneNdf::pdf_visible(up, h, d, g1v);
         let pr = pm * f / (R::splat(4.0) * oh.abs());
         let denom_p = n_o * oh + n_t * ih;
         let pt = pm * (R::one() - f) * n_t * n_t * ih.abs() / (denom_p * denom_p);
@@ -437,6 +464,7 @@ impl LaneBsdf {
         specular_probability: R,
         o: LVec3<R>,
         i: LVec3<R>,
+        (g1v, ratio): (R, R),
     ) -> (R, R) {
         let zero = R::zero();
         let above = o.z.gt(zero) & i.z.gt(zero);
@@ -444,10 +472,10 @@ impl LaneBsdf {
         let cos_oh = o.dot(h);
         let lobe = above & h.z.gt(zero) & cos_oh.gt(zero);
         let d = ndf.d(h);
-        let spec = d * ndf.g(i, o, h) / (R::splat(4.0) * o.z * i.z)
+        let spec = d * ndf.g_with_o(i, o, h, g1v * ratio) / (R::splat(4.0) * o.z * i.z)
             * fresnel_dielectric_lanes(cos_oh, R::splat(ni));
         let spec = R::select(lobe & spec.gt(zero), spec, zero);
-        let spec_pdf = ndf.pdf_visible(o, h, d) / (R::splat(4.0) * cos_oh);
+        let spec_pdf = LaneNdf::pdf_visible(o, h, d, g1v) / (R::splat(4.0) * cos_oh);
         let spec_pdf = R::select(lobe & spec_pdf.is_finite(), spec_pdf, zero);
         let ps = specular_probability;
         let pdf = ps * spec_pdf + (R::one() - ps) * R::masked(above, i.z * R::splat(INV_PI));
@@ -520,8 +548,10 @@ impl LaneBsdf {
                 let c = o.dot(m);
                 let i = m.scale(R::splat(2.0) * c) - o;
                 let d = ndf.d(m);
-                let pdf = ndf.pdf_visible(o, m, d) / (R::splat(4.0) * c);
-                let w = ndf.g(i, o, m) / ndf.g1_visible(o);
+                let (g1v, ratio) = ndf.g1_visible_and_ratio(o);
+                let pdf = LaneNdf::pdf_visible(o, m, d, g1v) / (R::splat(4.0) * c);
+                // G(i, o, m)/G1_v(o) with o·m = c > 0 (the lanes kept below).
+                let w = sided(i, m, ndf.g1_model(i)) * ratio;
                 let f = fresnel.eval(c);
                 let ok = !wo.z.eq(R::zero())
                     & c.gt(R::zero())
@@ -571,10 +601,11 @@ impl LaneBsdf {
                 let c = o.dot(m);
                 let reflected = m.scale(R::splat(2.0) * c) - o;
                 let i = LVec3::select(specular, reflected, cosine_hemisphere(u0, u1));
-                let lobe_pdf = ndf.pdf_visible(o, m, ndf.d(m)) / (R::splat(4.0) * c);
+                let g1o = ndf.g1_visible_and_ratio(o);
+                let lobe_pdf = LaneNdf::pdf_visible(o, m, ndf.d(m), g1o.0) / (R::splat(4.0) * c);
                 let lobe_ok = c.gt(R::zero()) & lobe_pdf.gt(R::zero()) & lobe_pdf.is_finite();
                 let drawn = !wo.z.eq(R::zero()) & i.z.gt(R::zero()) & (!specular | lobe_ok);
-                let (spec, pdf) = Self::il_specular(ndf, *ni, ps, o, i);
+                let (spec, pdf) = Self::il_specular(ndf, *ni, ps, o, i, g1o);
                 let valued = drawn & pdf.gt(R::zero());
                 let (b0, b1) = rng.next_2d(valued);
                 let b = Self::il_body(ndf, *ni, o, i, b0, b1);
@@ -643,7 +674,8 @@ impl LaneBsdf {
         let m = ndf.sample_visible(up, u0, u1);
         let c = wo.dot(m);
         let d = ndf.d(m);
-        let pm = ndf.pdf_visible(up, m, d);
+        let (g1v, ratio) = ndf.g1_visible_and_ratio(up);
+        let pm = LaneNdf::pdf_visible(up, m, d, g1v);
         let f = fresnel_dielectric_lanes(c.abs(), n_t / n_o);
         let choose_r = u_lobe.lt(f);
         let wr = m.scale(R::splat(2.0) * c) - wo;
@@ -652,7 +684,8 @@ impl LaneBsdf {
         let k = one + e * e * (c * c - one);
         let wt = m.scale(e * c - c.sign_or_one() * k.max(zero).sqrt()) - wo.scale(e);
         let wi = LVec3::select(choose_r, wr, wt);
-        let base = ndf.g(wo, wi, m) / ndf.g1_visible(up);
+        // G(wo, wi, m)/G1_v(wo) with (wo·m) wo_z > 0 (the lanes kept below).
+        let base = sided(wi, m, ndf.g1_model(wi)) * ratio;
         let wim = wi.dot(m);
         let denom = n_o * c + n_t * wim;
         let pr = pm * f / (R::splat(4.0) * c.abs());
