@@ -10,8 +10,9 @@
 //! samples, Sobol beyond 32 index bits).
 
 use super::sobol::{short_index_point, DimSeeds};
-use super::{independent_point, Layout, PixelSampler, SampleStream};
+use super::{independent_point, split, Layout, PixelSampler, SampleStream};
 use facette_bsdf::lanes::{Bits32, Real, U32x8};
+use facette_bsdf::math::rng::mix_seed;
 
 /// The dimensions whose Sobol seeds are tabulated per render (a path of up to 36 vertices
 /// at 7 dimensions each); deeper dimensions hash their seeds lane by lane.
@@ -158,6 +159,24 @@ impl PixelSampler {
                 out.fast = ((1u32 << n) - 1) as u8;
                 return out;
             }
+        }
+        if let Layout::Independent = &self.layout {
+            // A batch holds runs of one pixel's samples: the pixel's half of the key is
+            // hashed once a run.
+            let mut pixel_key = None;
+            for i in 0..n {
+                let pixel = self.pixel(xs[i], ys[i]);
+                let key = match pixel_key {
+                    Some((p, k)) if p == pixel => k,
+                    _ => {
+                        let k = self.independent_pixel_key(pixel);
+                        pixel_key = Some((pixel, k));
+                        k
+                    }
+                };
+                out.set_words(i, Some(split(mix_seed(key, samples[i]))));
+            }
+            return out;
         }
         for i in 0..n {
             out.set_words(i, self.lane_words_at(xs[i], ys[i], samples[i]));

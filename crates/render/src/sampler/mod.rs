@@ -156,7 +156,13 @@ impl PixelSampler {
     /// An independent sample's key.
     #[inline(always)]
     fn independent_key(&self, pixel: u64, sample_index: u64) -> u64 {
-        mix_seed(mix_seed(self.seed ^ INDEPENDENT_TAG, pixel), sample_index)
+        mix_seed(self.independent_pixel_key(pixel), sample_index)
+    }
+
+    /// The pixel's part of [`independent_key`](Self::independent_key).
+    #[inline(always)]
+    fn independent_pixel_key(&self, pixel: u64) -> u64 {
+        mix_seed(self.seed ^ INDEPENDENT_TAG, pixel)
     }
 
     /// The stream of one camera sample: a pure function of (seed, pixel, sample_index).
