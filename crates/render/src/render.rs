@@ -243,6 +243,9 @@ fn render_in_pool(
         h,
         spp,
     );
+    // Each tile's sums of a pass, kept from pass to pass: allocated anew, the passes'
+    // buffers (14 MB a pass at 512²) came back from the system page by page each time.
+    let mut tile_sums: Vec<Vec<PixelSums>> = vec![Vec::new(); tiles.len()];
     let mut first = 0;
     for (pass, size) in passes.into_iter().enumerate() {
         let chunk = &indices[first..first + size];
@@ -250,13 +253,14 @@ fn render_in_pool(
         if should_stop(pass) {
             break;
         }
-        let results: Vec<(usize, usize, Vec<PixelSums>)> = tiles
+        tiles
             .par_iter()
-            .map(|&(tx, ty)| {
+            .zip(tile_sums.par_iter_mut())
+            .for_each(|(&(tx, ty), out)| {
                 let x0 = tx * TILE;
                 let y0 = ty * TILE;
                 let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
-                let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
+                out.clear();
                 match kernel {
                     // `resolve` never gives `Auto`.
                     Kernel::Scalar | Kernel::Auto => {
@@ -293,17 +297,15 @@ fn render_in_pool(
                             chunk,
                             stop: &stop,
                         };
-                        let rows = packet::render_tile(&job, &mut out);
+                        let rows = packet::render_tile(&job, out);
                         let n = (rows * (x1 - x0) * chunk.len()) as u64;
                         let d = done.fetch_add(n, Ordering::Relaxed) + n;
                         progress(d, total);
                     }
                 }
-                (tx, ty, out)
-            })
-            .collect();
+            });
         // The pass's sums go to the film a band of TILE rows at a time, the bands in
-        // parallel (`results` is in `tiles`' order: band by band, each band's tiles left
+        // parallel (`tiles` is in order: band by band, each band's tiles left
         // to right). Merged serially, a pass cost ~45 instructions a pixel on one thread
         // while the others waited.
         let band = TILE * w;
@@ -312,10 +314,11 @@ fn render_in_pool(
             .par_chunks_mut(band)
             .zip(film.sq_sums.par_chunks_mut(band))
             .zip(film.counts.par_chunks_mut(band))
-            .zip(results.par_chunks(w.div_ceil(TILE)))
-            .map(|(((sums, sq_sums), counts), band_tiles)| {
+            .zip(tiles.par_chunks(w.div_ceil(TILE)))
+            .zip(tile_sums.par_chunks(w.div_ceil(TILE)))
+            .map(|((((sums, sq_sums), counts), band_tiles), band_sums)| {
                 let mut bad = 0;
-                for (tx, _, px) in band_tiles {
+                for (&(tx, _), px) in band_tiles.iter().zip(band_sums) {
                     let x0 = tx * TILE;
                     let tile_width = (x0 + TILE).min(w) - x0;
                     // A stopped tile holds the rows it started.
