@@ -108,7 +108,7 @@ fn include_and_ref_share_one_material() {
     assert_material(
         &s,
         gold,
-        "type = \"conductor\"\nmaterial = \"Au\"\ndistribution = \"beckmann\"\nalpha = 0.1",
+        "type = \"conductor\"\nmaterial = \"Au\"\ndistribution = \"beckmann\"\ng1 = \"rational\"\nalpha = 0.1",
         Vec2::ZERO,
     );
 }
@@ -438,7 +438,7 @@ fn bsdfs_map_to_facette_materials() {
         ("cu", "type = \"conductor\"\nalpha = 0\nmaterial = \"Cu\"\nspecular_reflectance = 0.9"),
         ("aniso", "type = \"conductor\"\ndistribution = \"ggx\"\nalpha_u = 0.1\nalpha_v = 0.3\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nsampling = \"distribution\""),
         ("water", "type = \"dielectric\"\nalpha = 0\nior = 1.333\next_ior = 1.0"),
-        ("glass", "type = \"dielectric\"\ndistribution = \"beckmann\"\nalpha = 0.2\nior = 1.5046\next_ior = 1.000277"),
+        ("glass", "type = \"dielectric\"\ndistribution = \"beckmann\"\ng1 = \"rational\"\nalpha = 0.2\nior = 1.5046\next_ior = 1.000277"),
         ("plastic", "type = \"il\"\nkd = 0.5\nni = 1.5\nalpha = 0"),
         ("roughplastic", "type = \"il\"\nkd = 0.3\nni = 1.5\ndistribution = \"ggx\"\nalpha = 0.3"),
         ("twosided", "type = \"lambert\"\nreflectance = 0.5"),

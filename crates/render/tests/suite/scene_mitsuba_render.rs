@@ -71,12 +71,12 @@ material = { type = "lambert", reflectance = 0.6 }
 shape = "sphere"
 center = [0, 0.5, 0]
 radius = 0.5
-material = { type = "conductor", material = "Au", distribution = "beckmann", alpha = 0.3 }
+material = { type = "conductor", material = "Au", distribution = "beckmann", g1 = "rational", alpha = 0.3 }
 [[objects]]
 shape = "sphere"
 center = [1.2, 0.4, 0.3]
 radius = 0.4
-material = { type = "dielectric", ior = 1.5, ext_ior = 1, distribution = "beckmann", alpha = 0.2 }
+material = { type = "dielectric", ior = 1.5, ext_ior = 1, distribution = "beckmann", g1 = "rational", alpha = 0.2 }
 [[objects]]
 shape = "rectangle"
 transform = [{ scale = 0.5 }, { rotate = { axis = [1, 0, 0], angle = 90 } }, { translate = [0, 3, 0] }]

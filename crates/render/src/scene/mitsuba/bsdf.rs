@@ -3,7 +3,7 @@
 //! | Mitsuba | facette |
 //! |---|---|
 //! | `diffuse` (`reflectance` 0.5) | `lambert` |
-//! | `conductor`, `roughconductor` (`distribution` beckmann/ggx, `alpha` 0.1 or `alpha_u` + `alpha_v`, `material` preset or `eta` + `k`, `specular_reflectance`, `sample_visible`) | `conductor` (`alpha = 0` when smooth; `sample_visible = false` → `sampling = "distribution"`) |
+//! | `conductor`, `roughconductor` (`distribution` beckmann/ggx, `alpha` 0.1 or `alpha_u` + `alpha_v`, `material` preset or `eta` + `k`, `specular_reflectance`, `sample_visible`) | `conductor` (`alpha = 0` when smooth; `sample_visible = false` → `sampling = "distribution"`; Beckmann with `g1 = "rational"`, Mitsuba's masking) |
 //! | `dielectric`, `roughdielectric` (`int_ior` bk7, `ext_ior` air, numbers or media names; `specular_reflectance`, `specular_transmittance`; microfacet keys as above) | `dielectric` (`ior`, `ext_ior`) |
 //! | `plastic`, `roughplastic` (`diffuse_reflectance` 0.5, `int_ior` polypropylene, `ext_ior` air, `nonlinear`; rough: `distribution`, `alpha`) | `il` — a Lambertian substrate under a dielectric interface, the same physical set-up, with `ni = int_ior / ext_ior` (see below for `nonlinear`) |
 //! | `twosided` (one BSDF, or the same one twice) | the wrapped BSDF (facette's reflective materials are two-sided) |
@@ -174,6 +174,11 @@ fn microfacet(
         return Err(p.err(format!(
             "unknown distribution `{distribution}`; valid: beckmann, ggx"
         )));
+    }
+    // Mitsuba's Beckmann masking is WMLT07's rational G1 (eq. 27, its `smith_g1`): the
+    // scene's model is that one, not facette's exact default.
+    if distribution == "beckmann" {
+        t.insert("g1".into(), "rational".into());
     }
     t.insert("distribution".into(), distribution.into());
     let alpha = roughness(cx, p, "alpha")?;
