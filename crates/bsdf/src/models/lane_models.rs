@@ -69,7 +69,8 @@ impl LaneNdf {
     /// G1_v of the density [Heitz 2014, eq. 2] (exact even where the model's G1 is a fit),
     /// and the model's G1 over it (1 where the model is exact). One evaluation of G1 serves
     /// the density and the masking of the view's side, which the sample's weight
-    /// G(i, o, m)/G1_v(o) [Heitz 2014, eq. 19] reduces to for separable Smith masking.
+    /// G(i, o, m)/G1_v(o) of visible-normal sampling [Heitz & d'Eon 2014] reduces to for
+    /// separable Smith masking.
     #[inline(always)]
     fn g1_visible_and_ratio<R: Real>(&self, v: LVec3<R>) -> (R, R) {
         match self {
