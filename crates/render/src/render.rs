@@ -308,14 +308,14 @@ fn render_in_pool(
         // parallel (`tiles` is in order: band by band, each band's tiles left
         // to right). Merged serially, a pass cost ~45 instructions a pixel on one thread
         // while the others waited.
-        let band = TILE * w;
+        let (band, tiles_a_band) = (TILE * w, w.div_ceil(TILE));
         film.discarded += film
             .sums
             .par_chunks_mut(band)
             .zip(film.sq_sums.par_chunks_mut(band))
             .zip(film.counts.par_chunks_mut(band))
-            .zip(tiles.par_chunks(w.div_ceil(TILE)))
-            .zip(tile_sums.par_chunks(w.div_ceil(TILE)))
+            .zip(tiles.par_chunks(tiles_a_band))
+            .zip(tile_sums.par_chunks(tiles_a_band))
             .map(|((((sums, sq_sums), counts), band_tiles), band_sums)| {
                 let mut bad = 0;
                 for (&(tx, _), px) in band_tiles.iter().zip(band_sums) {

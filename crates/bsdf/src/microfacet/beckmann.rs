@@ -204,11 +204,7 @@ impl Beckmann {
     /// G1(v, m) in the model's form, 0 where v sees the back of m (WMLT07 eq. 7's χ⁺).
     #[inline(always)]
     pub fn g1_lanes<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
-        R::select(
-            (v.dot(m) * v.z).le(R::zero()),
-            R::zero(),
-            self.g1_model_lanes(v),
-        )
+        super::sided_g1_lanes(v, m, self.g1_model_lanes(v))
     }
 
     /// D(m) = exp(−(x²/α_x² + y²/α_y²)/z²) / (π α_x α_y z⁴)  [IL18 eq. 16; WMLT07 eq. 25];

@@ -106,11 +106,7 @@ impl Ggx {
     /// 0 where v sees the back of m (WMLT07 eq. 7's χ⁺).
     #[inline(always)]
     pub fn g1_lanes<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
-        R::select(
-            (v.dot(m) * v.z).le(R::zero()),
-            R::zero(),
-            self.g1_unsided_lanes(v),
-        )
+        super::sided_g1_lanes(v, m, self.g1_unsided_lanes(v))
     }
 
     /// [`g1_lanes`](Self::g1_lanes) without the sidedness: 2z / (z + √(z² + α_v² sin² θ))

@@ -104,6 +104,13 @@ pub(crate) fn normal_from_slopes(sx: f64, sy: f64) -> Vec3 {
     normal_from_slopes_lanes(sx, sy).into()
 }
 
+/// `g1`, an unsided G1 of v, where v sees the front of m, else 0 (WMLT07 eq. 7's χ⁺): the
+/// sidedness of every lane G1.
+#[inline(always)]
+pub(crate) fn sided_g1_lanes<R: Real>(v: LVec3<R>, m: LVec3<R>, g1: R) -> R {
+    R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g1)
+}
+
 /// [`normal_from_slopes`] over lanes.
 #[inline(always)]
 pub(crate) fn normal_from_slopes_lanes<R: Real>(sx: R, sy: R) -> LVec3<R> {

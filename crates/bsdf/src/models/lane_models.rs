@@ -27,7 +27,7 @@ use crate::fresnel::dielectric::fresnel_dielectric_lanes;
 use crate::fresnel::Fresnel;
 use crate::lanes::{channels, map_channels, LVec3, Mask, Real};
 use crate::math::INV_PI;
-use crate::microfacet::{Beckmann, Ggx, Ndf};
+use crate::microfacet::{sided_g1_lanes, Beckmann, Ggx, Ndf};
 use crate::recipe::microfacet::with_roughness;
 use crate::{ParamError, ParamResult};
 
@@ -53,15 +53,6 @@ impl LaneNdf {
         match self {
             LaneNdf::Ggx(g) => g.d_lanes(m),
             LaneNdf::Beckmann(b) => b.d_lanes(m),
-        }
-    }
-
-    /// The model's G1(v, m), with WMLT07 eq. 7's sidedness.
-    #[inline(always)]
-    fn g1<R: Real>(&self, v: LVec3<R>, m: LVec3<R>) -> R {
-        match self {
-            LaneNdf::Ggx(g) => g.g1_lanes(v, m),
-            LaneNdf::Beckmann(b) => b.g1_lanes(v, m),
         }
     }
 
@@ -121,21 +112,15 @@ impl LaneNdf {
     /// G(i, o, m) with separable Smith masking [WMLT07 eq. 23].
     #[inline(always)]
     fn g<R: Real>(&self, i: LVec3<R>, o: LVec3<R>, m: LVec3<R>) -> R {
-        self.g1(i, m) * self.g1(o, m)
+        self.g_with_o(i, o, m, self.g1_model(o))
     }
 
     /// [`g`](Self::g) with o's unsided model G1 already known (`g1o`, from
     /// [`g1_visible_and_ratio`](Self::g1_visible_and_ratio) as G1_v × ratio).
     #[inline(always)]
     fn g_with_o<R: Real>(&self, i: LVec3<R>, o: LVec3<R>, m: LVec3<R>, g1o: R) -> R {
-        sided(i, m, self.g1_model(i)) * sided(o, m, g1o)
+        sided_g1_lanes(i, m, self.g1_model(i)) * sided_g1_lanes(o, m, g1o)
     }
-}
-
-/// `g1` (an unsided G1 of v) where v sees the front of m, else 0 (WMLT07 eq. 7's χ⁺).
-#[inline(always)]
-fn sided<R: Real>(v: LVec3<R>, m: LVec3<R>, g1: R) -> R {
-    R::select((v.dot(m) * v.z).le(R::zero()), R::zero(), g1)
 }
 
 /// A conductor's Fresnel term over lanes.
@@ -552,7 +537,7 @@ impl LaneBsdf {
                 let (g1v, ratio) = ndf.g1_visible_and_ratio(o);
                 let pdf = LaneNdf::pdf_visible(o, m, d, g1v) / (R::splat(4.0) * c);
                 // G(i, o, m)/G1_v(o) with o·m = c > 0 (the lanes kept below).
-                let w = sided(i, m, ndf.g1_model(i)) * ratio;
+                let w = sided_g1_lanes(i, m, ndf.g1_model(i)) * ratio;
                 let f = fresnel.eval(c);
                 let ok = !wo.z.eq(R::zero())
                     & c.gt(R::zero())
@@ -686,7 +671,7 @@ impl LaneBsdf {
         let wt = m.scale(e * c - c.sign_or_one() * k.max(zero).sqrt()) - wo.scale(e);
         let wi = LVec3::select(choose_r, wr, wt);
         // G(wo, wi, m)/G1_v(wo) with (wo·m) wo_z > 0 (the lanes kept below).
-        let base = sided(wi, m, ndf.g1_model(wi)) * ratio;
+        let base = sided_g1_lanes(wi, m, ndf.g1_model(wi)) * ratio;
         let wim = wi.dot(m);
         let denom = n_o * c + n_t * wim;
         let pr = pm * f / (R::splat(4.0) * c.abs());

@@ -426,8 +426,8 @@ struct VertexNumbers<S> {
 }
 
 /// The materials of a vertex: each lane's, the lanes whose material is a lane model, and
-/// whether those lanes share one model (then a model's group is found without comparing lanes) — found once, where the
-/// materials are looked up.
+/// whether those lanes share one model (then a model's group is found without comparing
+/// lanes) — found once, where the materials are looked up.
 struct VertexMaterials<'s> {
     /// The live lanes' materials (the other lanes' are left from earlier vertices).
     bsdfs: [VertexBsdf<'s>; LANES],
