@@ -259,6 +259,10 @@ impl Real for F32x8Avx2 {
         f32_polynomials::sin_cos(self)
     }
     #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        f32_polynomials::atan2(self, x)
+    }
+    #[inline(always)]
     fn exp(self) -> Self {
         f32_polynomials::exp(self)
     }

@@ -38,6 +38,10 @@ array_lanes!(
             F64x4(lanewise!(self.0, |a| a.floor()))
         }
         #[inline(always)]
+        fn atan2(self, x: Self) -> Self {
+            F64x4(std::array::from_fn(|i| self.0[i].atan2(x.0[i])))
+        }
+        #[inline(always)]
         fn exp(self) -> Self {
             F64x4(lanewise!(self.0, |a| a.exp()))
         }

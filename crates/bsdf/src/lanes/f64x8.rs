@@ -39,6 +39,10 @@ array_lanes!(
             F64x8(lanewise!(self.0, |a| a.floor()))
         }
         #[inline(always)]
+        fn atan2(self, x: Self) -> Self {
+            F64x8(std::array::from_fn(|i| self.0[i].atan2(x.0[i])))
+        }
+        #[inline(always)]
         fn exp(self) -> Self {
             F64x8(lanewise!(self.0, |a| a.exp()))
         }

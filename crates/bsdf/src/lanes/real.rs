@@ -108,6 +108,8 @@ pub trait Real:
     /// The largest integer not above each lane.
     fn floor(self) -> Self;
     fn sin_cos(self) -> (Self, Self);
+    /// The angle of the point (x, self) from the +x axis, in [−π, π] (`atan2(self, x)`).
+    fn atan2(self, x: Self) -> Self;
     fn exp(self) -> Self;
     fn ln(self) -> Self;
     /// Whether each lane is neither infinite nor NaN.
@@ -233,6 +235,10 @@ macro_rules! scalar_real {
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
                 $sin_cos(self)
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                <$t>::atan2(self, x)
             }
             #[inline(always)]
             fn exp(self) -> Self {
