@@ -7,6 +7,9 @@
 //!
 //! u = atan2(v.x, −v.z) / 2π  (wrapped into [0, 1)),   v_tex = acos(v.y) / π,
 //!
+//! (v_tex computed as atan2(√(v.x² + v.z²), v.y) / π, the same angle without acos's loss of
+//! precision near the poles),
+//!
 //! inversely v = (sin φ sin θ, cos θ, −cos φ sin θ) with φ = 2π u, θ = π v_tex. So +y is up
 //! (the top row), −z is the centre of the left edge (u = 0), +x is a quarter across
 //! (u = ¼), +z the middle (u = ½) and −x three quarters (u = ¾).
@@ -51,6 +54,7 @@
 
 use std::f64::consts::{FRAC_1_PI, PI};
 
+use facette_bsdf::lanes::{CellTable, LVec3, Mask, Real};
 use facette_bsdf::{ParamError, ParamResult, Spectrum};
 use glam::{DMat3, DVec2, DVec3};
 
@@ -60,8 +64,6 @@ use facette_bsdf::math::sin_cos::sin_cos;
 
 const TWO_PI: f64 = 2.0 * PI;
 const INV_TWO_PI: f64 = 0.5 * FRAC_1_PI;
-/// Largest f64 below 1.
-const ONE_MINUS_EPS: f64 = 1.0 - f64::EPSILON / 2.0;
 
 /// A direction drawn from an environment, its radiance and its density.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,6 +75,21 @@ pub struct EnvSample {
     /// `pdf(direction)`, per unit solid angle.
     pub pdf: f64,
 }
+
+/// [`EnvSample`]s in lanes: the lanes `drawn`, their directions, radiance and densities
+/// (the other lanes hold what they may).
+#[derive(Clone, Copy, Debug)]
+pub struct EnvSampleLanes<R: Real> {
+    pub drawn: R::Mask,
+    pub direction: LVec3<R>,
+    pub radiance: [R; 3],
+    pub pdf: R,
+}
+
+/// The most lanes [`EnvironmentMap::sample_lanes`] draws at once, and the per-lane numbers
+/// it gathers from the patches before the lane arithmetic.
+const MAX_LANES: usize = 16;
+const PATCH_FIELDS: usize = 12;
 
 /// Checks that `to_world` is a rotation (or a rotation with a mirror): the map's frame
 /// must stay orthonormal for directions and solid angles to carry over.
@@ -105,42 +122,58 @@ pub(crate) fn check_scale(scale: f64) -> ParamResult<()> {
 /// Mitsuba 3's `direction_to_uv` for a local unit direction, u wrapped into [0, 1).
 #[inline]
 pub fn direction_to_uv(v: DVec3) -> DVec2 {
-    let mut u = v.x.atan2(-v.z) * INV_TWO_PI;
-    if u < 0.0 {
-        u += 1.0;
-    }
-    if u >= 1.0 {
-        u -= 1.0;
-    }
-    DVec2::new(u, v.y.clamp(-1.0, 1.0).acos() * FRAC_1_PI)
+    let (u, w) = direction_to_uv_lanes(LVec3::<f64>::from(v));
+    DVec2::new(u, w)
+}
+
+/// [`direction_to_uv`] in lanes: u = atan2(x, −z)/2π wrapped into [0, 1), v = θ/π with
+/// θ = atan2(√(x² + z²), y) (Mitsuba's acos(y), see the module's notes).
+#[inline(always)]
+pub fn direction_to_uv_lanes<R: Real>(v: LVec3<R>) -> (R, R) {
+    let mut u = v.x.atan2(-v.z) * R::splat(INV_TWO_PI);
+    u = R::select(u.lt(R::zero()), u + R::one(), u);
+    // After the line above: −tiny + 1 rounds to 1.
+    u = R::select(u.ge(R::one()), u - R::one(), u);
+    let across = (v.x * v.x + v.z * v.z).sqrt();
+    (u, across.atan2(v.y) * R::splat(FRAC_1_PI))
 }
 
 /// Mitsuba 3's `uv_to_direction`: the local unit direction of texture coordinates `uv`.
 #[inline]
 pub fn uv_to_direction(uv: DVec2) -> DVec3 {
-    let (sin_theta, cos_theta) = (PI * uv.y).sin_cos();
-    let (sin_phi, cos_phi) = (TWO_PI * uv.x).sin_cos();
-    DVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta)
+    uv_to_direction_lanes(uv.x, uv.y).into()
+}
+
+/// [`uv_to_direction`] in lanes.
+#[inline(always)]
+fn uv_to_direction_lanes<R: Real>(u: R, v: R) -> LVec3<R> {
+    let (sin_theta, cos_theta) = (R::splat(PI) * v).sin_cos();
+    let (sin_phi, cos_phi) = (R::splat(TWO_PI) * u).sin_cos();
+    LVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta)
+}
+
+/// The largest lane value below 1: 1 − 2⁻⁵³ in f64, 1 − 2⁻²⁴ in f32.
+#[inline(always)]
+fn one_minus_eps<R: Real>() -> R {
+    R::splat(1.0 - 0.5f64.powi(R::DIGITS as i32))
 }
 
 /// Draws x ∈ [0, 1) with density ∝ (1 − x) a + x b (a, b ≥ 0, not both 0) by the closed-form
 /// inverse of its CDF, x = ξ(a + b) / (a + √((1 − ξ) a² + ξ b²)): no cancellation when
 /// a ≈ b, and a = 0 or b = 0 need no special case (only ξ = 0 with a = 0, which is 0).
-#[inline]
-fn sample_linear(xi: f64, a: f64, b: f64) -> f64 {
-    let den = a + ((1.0 - xi) * a * a + xi * b * b).sqrt();
-    if !(den > 0.0) {
-        return 0.0;
-    }
-    (xi * (a + b) / den).clamp(0.0, ONE_MINUS_EPS)
+#[inline(always)]
+fn sample_linear<R: Real>(xi: R, a: R, b: R) -> R {
+    let den = a + ((R::one() - xi) * a * a + xi * b * b).sqrt();
+    let x = (xi * (a + b) / den).max(R::zero()).min(one_minus_eps());
+    R::select(den.gt(R::zero()), x, R::zero())
 }
 
 /// ∫ τ sin(cτ) dτ over τ ∈ [−½, ½], by its Taylor series
 /// Σₖ (−1)ᵏ c^(2k+1) / ((2k+1)! (2k+3) 4^(k+1)) — the closed form cancels catastrophically
 /// for small c. For c ≤ π/2 (every patch: c = π Δv ≤ π/2) nine terms reach 1e-17 relative;
 /// the coefficients are the series' own, in Horner form.
-#[inline]
-fn odd_sin_moment(c: f64) -> f64 {
+#[inline(always)]
+fn odd_sin_moment<R: Real>(c: R) -> R {
     const A: [f64; 9] = [
         0.083_333_333_333_333_33,
         -0.002_083_333_333_333_333_3,
@@ -153,39 +186,62 @@ fn odd_sin_moment(c: f64) -> f64 {
         5.644_662_263_459_699e-22,
     ];
     let c2 = c * c;
-    let mut p = A[8];
+    let mut p = R::splat(A[8]);
     for &a in A[..8].iter().rev() {
-        p = p * c2 + a;
+        p = p * c2 + R::splat(a);
     }
     c * p
 }
 
+/// sin h and cos h for h ∈ [0, π/4] (half a patch row's angle, c t₁/2): for h ≤ 1/32 (rows
+/// of maps 64 or more pixels high) by their Taylor series to h⁷ and h⁸, whose remainders,
+/// below h⁹/9! and h¹⁰/10!, are under 3e-18 relative — a few multiplications where
+/// `sin_cos` reduces the argument and runs two polynomials (the row inversion's Newton
+/// steps call this once each, the largest cost of the environment map's sampler).
+#[inline(always)]
+fn small_sin_cos<R: Real>(h: R) -> (R, R) {
+    let z = h * h;
+    let s = h + h
+        * z
+        * (R::splat(-1.0 / 6.0) + z * (R::splat(1.0 / 120.0) - z * R::splat(1.0 / 5040.0)));
+    let c = (R::one() - R::splat(0.5) * z)
+        + z * z
+            * (R::splat(1.0 / 24.0) + z * (R::splat(-1.0 / 720.0) + z * R::splat(1.0 / 40320.0)));
+    let wide = !h.le(R::splat(1.0 / 32.0));
+    if wide.any() {
+        let (sw, cw) = h.sin_cos();
+        return (R::select(wide, sw, s), R::select(wide, cw, c));
+    }
+    (s, c)
+}
+
 /// A patch row's density in t ∈ [0, 1]: ((1 − t) top + t bottom) sin(a + c t)
-/// (a, a + c ∈ [0, π]), with its closed-form CDF.
+/// (a, a + c ∈ [0, π]), with its closed-form CDF; a row per lane.
 #[derive(Clone, Copy, Debug)]
-struct PatchRow {
-    angles: RowAngles,
-    c: f64,
-    top: f64,
-    bottom: f64,
+struct PatchRow<R> {
+    angles: RowAngles<R>,
+    c: R,
+    top: R,
+    bottom: R,
 }
 
 /// What a patch row's points share, kept by the map per row: sin a and cos a, so that a
 /// point costs one `sin_cos` (of h, see [`PatchRow::at`]) instead of two, and the row's end
 /// (t₁ = 1, which every draw reads) none: sin and cos of c/2 and ∫ τ sin(cτ) dτ.
 #[derive(Clone, Copy, Debug)]
-struct RowAngles {
-    sin_a: f64,
-    cos_a: f64,
-    sin_half_c: f64,
-    cos_half_c: f64,
-    odd_c: f64,
+struct RowAngles<R> {
+    sin_a: R,
+    cos_a: R,
+    sin_half_c: R,
+    cos_half_c: R,
+    odd_c: R,
 }
 
-impl RowAngles {
-    fn new(a: f64, c: f64) -> RowAngles {
+impl RowAngles<f64> {
+    fn new(a: f64, c: f64) -> RowAngles<f64> {
         let (sin_a, cos_a) = sin_cos(a);
-        let (sin_half_c, cos_half_c) = sin_cos(0.5 * c);
+        // As `PatchRow::at(1)` computes them, so that the kept end is that point to the bit.
+        let (sin_half_c, cos_half_c) = small_sin_cos(0.5 * c);
         RowAngles {
             sin_a,
             cos_a,
@@ -198,16 +254,16 @@ impl RowAngles {
 
 /// What [`PatchRow::at`] gives: the CDF at t₁, the density at t₁, and sin a (the density's
 /// sine at t = 0).
-struct RowPoint {
-    cdf: f64,
-    density: f64,
-    sin_start: f64,
+struct RowPoint<R> {
+    cdf: R,
+    density: R,
+    sin_start: R,
 }
 
-impl PatchRow {
+impl PatchRow<f64> {
     /// The row from a = π v₀ and c = π Δv (the map makes its rows from the angles it keeps).
     #[cfg(test)]
-    fn new(a: f64, c: f64, top: f64, bottom: f64) -> PatchRow {
+    fn new(a: f64, c: f64, top: f64, bottom: f64) -> PatchRow<f64> {
         PatchRow {
             angles: RowAngles::new(a, c),
             c,
@@ -215,42 +271,45 @@ impl PatchRow {
             bottom,
         }
     }
+}
 
+impl<R: Real> PatchRow<R> {
     /// The mass on [0, t₁] and the density at t₁, from the moments about the midpoint
     /// m = a + h, h = c t₁ / 2, so that neither cancels for small c:
     /// ∫₀¹ sin(a + c t₁ r) dr = sin m · sinc h and ∫₀¹ r sin(a + c t₁ r) dr = half of it +
     /// cos m · ∫ τ sin(c t₁ τ) dτ; top ∫₀^t₁ (1 − t) sin + bottom ∫₀^t₁ t sin are two
     /// non-negative terms. The `sin_cos` of h and the row's sin a, cos a give these (m's by
     /// the angle-sum formulas) and the sines at both ends, sin(m ± h).
-    #[inline]
-    fn at(&self, t1: f64) -> RowPoint {
-        let h = 0.5 * self.c * t1;
-        let (sh, ch) = sin_cos(h);
+    #[inline(always)]
+    fn at(&self, t1: R) -> RowPoint<R> {
+        let h = R::splat(0.5) * self.c * t1;
+        let (sh, ch) = small_sin_cos(h);
         self.point(t1, h, sh, ch, odd_sin_moment(self.c * t1))
     }
 
     /// [`at`](Self::at)`(1)` from the row's kept angles.
-    #[inline]
-    fn end(&self) -> RowPoint {
+    #[inline(always)]
+    fn end(&self) -> RowPoint<R> {
         let g = &self.angles;
-        self.point(1.0, 0.5 * self.c, g.sin_half_c, g.cos_half_c, g.odd_c)
+        let h = R::splat(0.5) * self.c;
+        self.point(R::one(), h, g.sin_half_c, g.cos_half_c, g.odd_c)
     }
 
     /// [`at`](Self::at)`(t1)` given h = c t₁/2, sin h, cos h and ∫ τ sin(c t₁ τ) dτ.
-    #[inline]
-    fn point(&self, t1: f64, h: f64, sh: f64, ch: f64, odd: f64) -> RowPoint {
+    #[inline(always)]
+    fn point(&self, t1: R, h: R, sh: R, ch: R, odd: R) -> RowPoint<R> {
         let (sa, ca) = (self.angles.sin_a, self.angles.cos_a);
         let (sm, cm) = (sa * ch + ca * sh, ca * ch - sa * sh);
-        let sinc = if h == 0.0 { 1.0 } else { sh / h };
+        let sinc = R::select(h.eq(R::zero()), R::one(), sh / h);
         let p0 = sm * sinc;
-        let p1 = 0.5 * p0 + cm * odd;
-        let lo = (t1 * (p0 - t1 * p1)).max(0.0);
-        let hi = (t1 * t1 * p1).max(0.0);
-        let sin_end = (sm * ch + cm * sh).max(0.0);
+        let p1 = R::splat(0.5) * p0 + cm * odd;
+        let lo = (t1 * (p0 - t1 * p1)).max(R::zero());
+        let hi = (t1 * t1 * p1).max(R::zero());
+        let sin_end = (sm * ch + cm * sh).max(R::zero());
         RowPoint {
             cdf: self.top * lo + self.bottom * hi,
-            density: ((1.0 - t1) * self.top + t1 * self.bottom) * sin_end,
-            sin_start: sa.max(0.0),
+            density: ((R::one() - t1) * self.top + t1 * self.bottom) * sin_end,
+            sin_start: sa.max(R::zero()),
         }
     }
 
@@ -258,42 +317,47 @@ impl PatchRow {
     /// inside a shrinking bracket by bisection, started from the linear density through the
     /// end values. Newton converges quadratically from there, so a step below 1e-10 leaves
     /// an error far below f64's resolution of t and ends the iteration (usually after two
-    /// evaluations; one more would only confirm it).
-    fn sample(&self, xi: f64) -> f64 {
+    /// evaluations; one more would only confirm it). f32 lanes stop at their own
+    /// resolution: a residual of 1e-6 of the row's mass, a step of 1e-5 or a bracket of 1e-6.
+    /// Each lane stops on its own; the others go on.
+    #[inline(always)]
+    fn sample(&self, xi: R) -> R {
+        let (residual, step_end, bracket_end) = if R::DIGITS > 24 {
+            (1e-14, 1e-10, 1e-15)
+        } else {
+            (1e-6, 1e-5, 1e-6)
+        };
         let end = self.end();
         let total = end.cdf;
-        if !(total > 0.0) {
-            return xi;
-        }
+        let has_mass = total.gt(R::zero());
         let target = xi * total;
-        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let (mut lo, mut hi) = (R::zero(), R::one());
         let mut t = sample_linear(xi, self.top * end.sin_start, end.density);
+        let mut active = has_mass;
         for _ in 0..64 {
             let point = self.at(t);
             let f = point.cdf - target;
             // At the CDF's rounding: the bracket's end there may be a hair past the root,
             // where a Newton step would fall outside and only bisect.
-            if f.abs() <= 1e-14 * total {
+            active = active & !f.abs().le(R::splat(residual) * total);
+            if active.none() {
                 break;
             }
-            if f > 0.0 {
-                hi = t;
-            } else {
-                lo = t;
-            }
+            let above = f.gt(R::zero());
+            hi = R::select(active & above, t, hi);
+            lo = R::select(active & !above, t, lo);
             let newton = t - f / point.density;
-            let (next, bisected) = if newton > lo && newton < hi {
-                (newton, false)
-            } else {
-                (0.5 * (lo + hi), true)
-            };
+            let inside = newton.gt(lo) & newton.lt(hi);
+            let next = R::select(inside, newton, R::splat(0.5) * (lo + hi));
             let step = (next - t).abs();
-            t = next;
-            if (!bisected && step <= 1e-10) || hi - lo <= 1e-15 {
+            t = R::select(active, next, t);
+            let converged = inside & step.le(R::splat(step_end));
+            active = active & !(converged | (hi - lo).le(R::splat(bracket_end)));
+            if active.none() {
                 break;
             }
         }
-        t.clamp(0.0, ONE_MINUS_EPS)
+        R::select(has_mass, t.max(R::zero()).min(one_minus_eps()), xi)
     }
 }
 
@@ -303,41 +367,21 @@ fn patch_row_cdf(a: f64, c: f64, top: f64, bottom: f64, t1: f64) -> f64 {
     PatchRow::new(a, c, top, bottom).at(t1).cdf
 }
 
-/// The four pixels around a point of the map (upper left, upper right, lower left, lower
-/// right) and the point's fractions between them.
-struct Taps {
-    texels: [[f32; 3]; 4],
-    fx: f64,
-    fy: f64,
-}
-
-impl Taps {
-    /// Bilinear interpolation of `f(pixel)`.
-    #[inline]
-    fn interpolate<T>(&self, f: impl Fn([f32; 3]) -> T) -> T
-    where
-        T: std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
-    {
-        let [a, b, c, d] = self.texels;
-        let (fx, fy) = (self.fx, self.fy);
-        let top = f(a) * (1.0 - fx) + f(b) * fx;
-        let bottom = f(c) * (1.0 - fx) + f(d) * fx;
-        top * (1.0 - fy) + bottom * fy
-    }
-}
-
 #[derive(Clone, Debug)]
 pub struct EnvironmentMap {
     image: RgbImage,
     to_world: DMat3,
     to_local: DMat3,
     scale: f64,
+    /// Each pixel's red, green, blue and luminance (unscaled), the cells that `eval` and
+    /// `pdf` interpolate, in both precisions for the lanes.
+    texels: CellTable,
     /// Over the W × (H + 1) patches between pixel centres, weights ∫∫ Y sin(πv) du dv.
     distribution: Distribution2D,
     /// 1 / (2π² Σ weights) = 1 / ∫Y dω (unscaled); 0 for a black map.
     inv_integral: f64,
     /// What the points of each patch row share ([`PatchRow`]).
-    row_angles: Vec<RowAngles>,
+    row_angles: Vec<RowAngles<f64>>,
     mean: Spectrum,
 }
 
@@ -349,6 +393,12 @@ fn patch_row(j: usize, h: usize) -> (usize, usize, f64, f64) {
     let v0 = if j == 0 { 0.0 } else { (j as f64 - 0.5) / hf };
     let v1 = if j == h { 1.0 } else { (j as f64 + 0.5) / hf };
     (j.saturating_sub(1), j.min(h - 1), v0, v1 - v0)
+}
+
+/// A vector's three coordinates in every lane.
+#[inline(always)]
+fn splat_vec<R: Real>(c: DVec3) -> LVec3<R> {
+    LVec3::new(R::splat(c.x), R::splat(c.y), R::splat(c.z))
 }
 
 /// Luminance of a stored (non-negative) pixel.
@@ -442,7 +492,18 @@ impl EnvironmentMap {
         }
         let mean = sum * (scale / (4.0 * PI));
 
+        let texels = CellTable::new(
+            image
+                .data()
+                .iter()
+                .map(|&p| {
+                    let c = to_spectrum(p);
+                    [c.0[0], c.0[1], c.0[2], luminance(p)]
+                })
+                .collect(),
+        );
         Ok(EnvironmentMap {
+            texels,
             image,
             to_world,
             to_local: to_world.transpose(),
@@ -479,12 +540,25 @@ impl EnvironmentMap {
     /// or non-finite vector.
     #[inline]
     pub fn uv(&self, d: DVec3) -> Option<DVec2> {
-        let v = self.to_local * d;
-        let len = v.length();
-        if !(len > 0.0) || !len.is_finite() {
-            return None;
-        }
-        Some(direction_to_uv(v / len))
+        let (ok, u, v) = self.uv_lanes(LVec3::<f64>::from(d));
+        ok.then(|| DVec2::new(u, v))
+    }
+
+    /// [`uv`](Self::uv) in lanes, with the lanes where `d` is neither zero nor non-finite
+    /// (the others hold the coordinates of the map's +y).
+    #[inline(always)]
+    pub fn uv_lanes<R: Real>(&self, d: LVec3<R>) -> (R::Mask, R, R) {
+        let m = &self.to_local;
+        // glam's order of the product's sums, and its `length` and division.
+        let v = splat_vec::<R>(m.x_axis).scale(d.x)
+            + splat_vec::<R>(m.y_axis).scale(d.y)
+            + splat_vec::<R>(m.z_axis).scale(d.z);
+        let len = v.length_squared().sqrt();
+        let ok = len.gt(R::zero()) & len.is_finite();
+        let unit = LVec3::new(v.x / len, v.y / len, v.z / len);
+        let unit = LVec3::select(ok, unit, LVec3::new(R::zero(), R::one(), R::zero()));
+        let (u, w) = direction_to_uv_lanes(unit);
+        (ok, u, w)
     }
 
     /// The world direction of texture coordinates `uv`.
@@ -493,132 +567,213 @@ impl EnvironmentMap {
         self.to_world * uv_to_direction(uv)
     }
 
-    #[inline]
-    fn texel(&self, x: usize, y: usize) -> [f32; 3] {
-        self.image.data()[y * self.image.width() + x]
+    /// Whether [`eval_pdf_lanes`](Self::eval_pdf_lanes) serves lanes of type `R`: a cell is
+    /// indexed by a lane, which holds every integer below 2^digits exactly.
+    pub fn serves_lanes<R: Real>(&self) -> bool {
+        self.texels.len() as f64 <= 2f64.powi(R::DIGITS as i32)
     }
 
-    /// The four texels around `uv` and their weights: bilinear interpolation between pixel
-    /// centres, wrapping in u and clamping at the poles — the one interpolation behind both
-    /// `eval` and `pdf`.
-    #[inline]
-    fn taps(&self, uv: DVec2) -> Taps {
-        let (w, h) = (self.image.width(), self.image.height());
-        let x = uv.x * w as f64 - 0.5;
-        let y = uv.y * h as f64 - 0.5;
+    /// Radiance (times `scale`) and density at texture coordinates (u, v) ∈ [0, 1)² in
+    /// lanes: the red, green, blue and luminance of the four pixels around (u, v),
+    /// interpolated bilinearly between pixel centres, wrapping in u and clamping at the
+    /// poles — the one interpolation behind `eval`, `pdf` and `sample`.
+    #[inline(always)]
+    fn lookup_lanes<R: Real>(&self, u: R, v: R) -> ([R; 3], R) {
+        let (w, h) = (self.image.width() as f64, self.image.height() as f64);
+        let x = u * R::splat(w) - R::splat(0.5);
+        let y = v * R::splat(h) - R::splat(0.5);
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let xa = (x0 as i64).rem_euclid(w as i64) as usize;
-        let xb = if xa + 1 == w { 0 } else { xa + 1 };
-        let ya = (y0 as i64).clamp(0, h as i64 - 1) as usize;
-        let yb = (y0 as i64 + 1).clamp(0, h as i64 - 1) as usize;
-        Taps {
-            texels: [
-                self.texel(xa, ya),
-                self.texel(xb, ya),
-                self.texel(xa, yb),
-                self.texel(xb, yb),
-            ],
-            fx,
-            fy,
+        // x0 ∈ [−1, W − 1] and y0 ∈ [−1, H − 1] for (u, v) ∈ [0, 1)²: the left neighbour
+        // of column 0 is column W − 1; the clamps keep rounding inside the table.
+        let xa = R::select(x0.lt(R::zero()), x0 + R::splat(w), x0).clamp(0.0, w - 1.0);
+        let next = xa + R::one();
+        let xb = R::select(next.ge(R::splat(w)), R::zero(), next);
+        let ya = y0.clamp(0.0, h - 1.0) * R::splat(w);
+        let yb = (y0 + R::one()).clamp(0.0, h - 1.0) * R::splat(w);
+        let a = R::gather4(&self.texels, ya + xa);
+        let b = R::gather4(&self.texels, ya + xb);
+        let c = R::gather4(&self.texels, yb + xa);
+        let d = R::gather4(&self.texels, yb + xb);
+        let (gx, gy) = (R::one() - fx, R::one() - fy);
+        let mut out = [R::zero(); 4];
+        for k in 0..4 {
+            let top = a[k] * gx + b[k] * fx;
+            let bottom = c[k] * gx + d[k] * fx;
+            out[k] = top * gy + bottom * fy;
         }
+        let scale = R::splat(self.scale);
+        (
+            [out[0] * scale, out[1] * scale, out[2] * scale],
+            out[3] * R::splat(self.inv_integral),
+        )
     }
 
     /// Radiance arriving along world direction `d` (bilinear, times `scale`); black for a
     /// degenerate `d`.
     pub fn eval(&self, d: DVec3) -> Spectrum {
-        self.uv(d).map_or(Spectrum::ZERO, |uv| self.eval_uv(uv))
-    }
-
-    /// Radiance at texture coordinates `uv` ∈ [0, 1)² (bilinear, times `scale`).
-    fn eval_uv(&self, uv: DVec2) -> Spectrum {
-        self.radiance_of(&self.taps(uv))
-    }
-
-    #[inline]
-    fn radiance_of(&self, taps: &Taps) -> Spectrum {
-        taps.interpolate(to_spectrum) * self.scale
-    }
-
-    #[inline]
-    fn density_of(&self, taps: &Taps) -> f64 {
-        if self.inv_integral == 0.0 {
-            return 0.0;
-        }
-        taps.interpolate(luminance) * self.inv_integral
+        self.eval_pdf(d).0
     }
 
     /// [`eval`](Self::eval) and [`pdf`](Self::pdf) of `d` together, from one look-up of its
     /// texture coordinates (what a ray leaving the scene needs for its MIS weight).
     pub fn eval_pdf(&self, d: DVec3) -> (Spectrum, f64) {
-        self.uv(d).map_or((Spectrum::ZERO, 0.0), |uv| {
-            let taps = self.taps(uv);
-            (self.radiance_of(&taps), self.density_of(&taps))
-        })
+        let (radiance, pdf) = self.eval_pdf_lanes(LVec3::<f64>::from(d));
+        (Spectrum(radiance), pdf)
     }
 
-    /// Density (per unit solid angle) with which [`EnvironmentMap::sample`] produces `d`.
-    pub fn pdf(&self, d: DVec3) -> f64 {
-        self.uv(d).map_or(0.0, |uv| self.pdf_uv(uv))
+    /// [`eval_pdf`](Self::eval_pdf) in lanes (zero where `d` is zero or not finite), for
+    /// lane types the map [serves](Self::serves_lanes).
+    #[inline(always)]
+    pub fn eval_pdf_lanes<R: Real>(&self, d: LVec3<R>) -> ([R; 3], R) {
+        let (ok, u, v) = self.uv_lanes(d);
+        let (radiance, pdf) = self.lookup_lanes(u, v);
+        (radiance.map(|c| R::masked(ok, c)), R::masked(ok, pdf))
     }
 
-    /// Y(uv) / ∫Y dω: the sampler's density in uv, Y sin(πv) / ∫∫ Y sin(πv) du dv, over the
+    /// Density (per unit solid angle) with which [`EnvironmentMap::sample`] produces `d`:
+    /// Y(uv) / ∫Y dω, the sampler's density in uv, Y sin(πv) / ∫∫ Y sin(πv) du dv, over the
     /// Jacobian dω / du dv = 2π² sin θ (the sin θ cancels).
-    fn pdf_uv(&self, uv: DVec2) -> f64 {
-        self.density_of(&self.taps(uv))
+    pub fn pdf(&self, d: DVec3) -> f64 {
+        self.eval_pdf(d).1
     }
 
     /// Draws a direction with density proportional to the luminance of `eval`. `None` when
     /// the map is black.
     pub fn sample(&self, u: DVec2) -> Option<EnvSample> {
+        let s = self.sample_lanes(u.x, u.y, true);
+        s.drawn.then(|| EnvSample {
+            direction: s.direction.into(),
+            radiance: Spectrum(s.radiance),
+            pdf: s.pdf,
+        })
+    }
+
+    /// [`sample`](Self::sample) in lanes, for the lanes of `set` (the lanes a map
+    /// [serves](Self::serves_lanes)): the patch of each lane is drawn from the f64 CDFs lane
+    /// by lane, the point inside it and its radiance and density for every lane at once.
+    #[inline(always)]
+    pub fn sample_lanes<R: Real>(&self, u0: R, u1: R, set: R::Mask) -> EnvSampleLanes<R> {
+        let mut drawn = R::Mask::splat(false);
+        let none = EnvSampleLanes {
+            drawn,
+            direction: LVec3::zero(),
+            radiance: [R::zero(); 3],
+            pdf: R::zero(),
+        };
         if self.inv_integral == 0.0 {
-            return None;
+            return none;
         }
-        let (x, j, _, f) = self.distribution.sample(u)?;
         let (w, h) = (self.image.width(), self.image.height());
-        let (ra, rb, v0, dv) = patch_row(j, h);
-        let xb = if x + 1 == w { 0 } else { x + 1 };
-        let corner = |x: usize, y: usize| luminance(self.texel(x, y));
-        let (l00, l10) = (corner(x, ra), corner(xb, ra));
-        let (l01, l11) = (corner(x, rb), corner(xb, rb));
+        // Per lane: the patch's column x, its corner pixel rows, v₀, Δv, the row's angles
+        // and the position ξ inside the patch.
+        let mut patch = [[0.0f64; PATCH_FIELDS]; MAX_LANES];
+        debug_assert!(R::LANES <= MAX_LANES);
+        for (i, lane) in patch.iter_mut().enumerate().take(R::LANES) {
+            if !set.lane(i) {
+                continue;
+            }
+            let Some((x, j, _, f)) = self.distribution.sample(DVec2::new(u0.lane(i), u1.lane(i)))
+            else {
+                continue;
+            };
+            let (ra, rb, v0, dv) = patch_row(j, h);
+            let g = &self.row_angles[j];
+            *lane = [
+                x as f64,
+                (ra * w) as f64,
+                (rb * w) as f64,
+                v0,
+                dv,
+                g.sin_a,
+                g.cos_a,
+                g.sin_half_c,
+                g.cos_half_c,
+                g.odd_c,
+                f.x,
+                f.y,
+            ];
+            drawn = drawn | R::Mask::from_fn(|k| k == i);
+        }
+        if drawn.none() {
+            return none;
+        }
+        // Functions, not closures, so that they inline into the render kernel's AVX2 code.
+        #[inline(always)]
+        fn field<R: Real>(patch: &[[f64; PATCH_FIELDS]; MAX_LANES], k: usize) -> R {
+            R::from_fn(|i| patch[i][k])
+        }
+        #[inline(always)]
+        fn nudge<R: Real>(v: R) -> R {
+            const NUDGE: f64 = 1e-6;
+            v + R::splat(NUDGE) * (R::splat(0.5) - v)
+        }
+        let luminance_at = |cell: R| R::gather4(&self.texels, cell)[3];
+        let x: R = field(&patch, 0);
+        let (row_a, row_b): (R, R) = (field(&patch, 1), field(&patch, 2));
+        let (v0, dv): (R, R) = (field(&patch, 3), field(&patch, 4));
+        let next = x + R::one();
+        let xb = R::select(next.eq(R::splat(w as f64)), R::zero(), next);
+        let (l00, l10) = (luminance_at(row_a + x), luminance_at(row_a + xb));
+        let (l01, l11) = (luminance_at(row_b + x), luminance_at(row_b + xb));
         // v from the marginal, linear in v (the means of the upper and lower corners) times
         // sin(πv); then u from the linear conditional at that v.
+        let half = R::splat(0.5);
         let row = PatchRow {
-            angles: self.row_angles[j],
-            c: PI * dv,
-            top: 0.5 * (l00 + l10),
-            bottom: 0.5 * (l01 + l11),
+            angles: RowAngles {
+                sin_a: field(&patch, 5),
+                cos_a: field(&patch, 6),
+                sin_half_c: field(&patch, 7),
+                cos_half_c: field(&patch, 8),
+                odd_c: field(&patch, 9),
+            },
+            c: R::splat(PI) * dv,
+            top: half * (l00 + l10),
+            bottom: half * (l01 + l11),
         };
-        let t = row.sample(f.y);
-        let left = (1.0 - t) * l00 + t * l01;
-        let right = (1.0 - t) * l10 + t * l11;
-        let s = sample_linear(f.x, left, right);
-        let place = |s: f64, t: f64| {
-            let mut uu = (x as f64 + 0.5 + s) / w as f64;
-            if uu >= 1.0 {
-                uu -= 1.0;
-            }
-            let vv = (v0 + dv * t).min(1.0);
-            let direction = self.direction(DVec2::new(uu, vv)).normalize();
-            // Re-derive uv from the direction, so that the density and radiance equal
-            // `pdf(direction)` and `eval(direction)` to the bit.
-            let uv = self.uv(direction)?;
-            let taps = self.taps(uv);
-            let pdf = self.density_of(&taps);
-            (pdf > 0.0).then(|| EnvSample {
-                direction,
-                radiance: self.radiance_of(&taps),
-                pdf,
-            })
-        };
+        let t = row.sample(field(&patch, 11));
+        let left = (R::one() - t) * l00 + t * l01;
+        let right = (R::one() - t) * l10 + t * l11;
+        let s = sample_linear(field(&patch, 10), left, right);
+        let mut out = self.place(x, v0, dv, s, t);
         // The inversion maps the (null) set where the density vanishes — ξ = 0 on a patch
         // edge with black corners — onto points of zero density; such a draw is moved a
         // hair towards the patch centre, where the density is positive (the patch has
         // mass), so a non-black map always yields a sample.
-        place(s, t).or_else(|| {
-            const NUDGE: f64 = 1e-6;
-            place(s + NUDGE * (0.5 - s), t + NUDGE * (0.5 - t))
-        })
+        let empty = drawn & !out.pdf.gt(R::zero());
+        if empty.any() {
+            let again = self.place(x, v0, dv, nudge(s), nudge(t));
+            out.direction = LVec3::select(empty, again.direction, out.direction);
+            for c in 0..3 {
+                out.radiance[c] = R::select(empty, again.radiance[c], out.radiance[c]);
+            }
+            out.pdf = R::select(empty, again.pdf, out.pdf);
+        }
+        out.drawn = drawn & out.pdf.gt(R::zero());
+        out
+    }
+
+    /// The direction at (s, t) of patch column `x` of the row [v₀, v₀ + Δv], with `eval` and
+    /// `pdf` of that direction: its uv re-derived from it, so that they equal
+    /// `eval(direction)` and `pdf(direction)` to the bit.
+    #[inline(always)]
+    fn place<R: Real>(&self, x: R, v0: R, dv: R, s: R, t: R) -> EnvSampleLanes<R> {
+        let mut uu = (x + R::splat(0.5) + s) / R::splat(self.image.width() as f64);
+        uu = R::select(uu.ge(R::one()), uu - R::one(), uu);
+        let vv = (v0 + dv * t).min(R::one());
+        let local = uv_to_direction_lanes(uu, vv);
+        let m = &self.to_world;
+        let direction = (splat_vec::<R>(m.x_axis).scale(local.x)
+            + splat_vec::<R>(m.y_axis).scale(local.y)
+            + splat_vec::<R>(m.z_axis).scale(local.z))
+        .normalize();
+        let (radiance, pdf) = self.eval_pdf_lanes(direction);
+        EnvSampleLanes {
+            drawn: R::Mask::splat(true),
+            direction,
+            radiance,
+            pdf,
+        }
     }
 
     /// Mean radiance over the sphere, (1/4π) ∫ L dω, from the pixel values weighted by
@@ -784,17 +939,34 @@ mod tests {
     }
 
     #[test]
+    fn small_sin_cos_is_libms_within_rounding() {
+        let n = 100_000;
+        for k in 0..=n {
+            // Up to the switch to `sin_cos` (1/32) and beyond it.
+            let h = 0.04 * k as f64 / n as f64;
+            let (s, c) = small_sin_cos(h);
+            let (es, ec) = h.sin_cos();
+            assert!(
+                (s - es).abs() <= 2.5e-16 * es.max(1e-300),
+                "sin {h}: {s} {es}"
+            );
+            assert!((c - ec).abs() <= 1.2e-16, "cos {h}: {c} {ec}");
+        }
+    }
+
+    #[test]
     fn row_inversion_hits_its_cdf() {
         for (a, c) in [
             (0.0, PI / 2.0),
             (PI / 2.0, PI / 2.0),
             (0.0, 1e-3),
+            (1.0, PI / 256.0),
             (3.0, 0.1),
         ] {
             for (top, bottom) in [(1.0, 1.0), (0.0, 1.0), (1.0, 0.0), (1e-9, 5.0), (3.0, 2.0)] {
                 let total = patch_row_cdf(a, c, top, bottom, 1.0);
                 for k in 0..=64 {
-                    let xi = (k as f64 / 64.0).min(ONE_MINUS_EPS);
+                    let xi = (k as f64 / 64.0).min(one_minus_eps::<f64>());
                     let row = PatchRow::new(a, c, top, bottom);
                     // The kept end is the computed one, to the bit.
                     let (end, at_one) = (row.end(), row.at(1.0));
@@ -827,7 +999,7 @@ mod tests {
             (0.0, 0.0),
         ] {
             for k in 0..=16 {
-                let xi = (k as f64 / 16.0).min(ONE_MINUS_EPS);
+                let xi = (k as f64 / 16.0).min(one_minus_eps::<f64>());
                 let x = sample_linear(xi, a, b);
                 assert!((0.0..1.0).contains(&x));
                 if a + b > 0.0 {

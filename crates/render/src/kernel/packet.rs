@@ -882,6 +882,21 @@ impl<'s> Kernel<'s> {
             Self::add_radiance(paths, set, &rgb_splat(c.mean_radiance()), w);
             return;
         }
+        if let Environment::Map(map) = e {
+            if map.serves_lanes::<G>() {
+                // Every lane's look-up at once; the black ones (zero luminance) add nothing.
+                let (le, pdf) = map.eval_pdf_lanes(paths.d);
+                let lit = le[0].gt(G::zero()) | le[1].gt(G::zero()) | le[2].gt(G::zero());
+                let set = missed & set_of(lit);
+                if set != 0 {
+                    let le: Rgb<S> = [conv(le[0]), conv(le[1]), conv(le[2])];
+                    let pl = S::splat(p_select) * conv::<G, S>(pdf);
+                    let w = self.emission_weight(paths.delta_prev, paths.prev_pdf, pl);
+                    Self::add_radiance(paths, set, &le, w);
+                }
+                return;
+            }
+        }
         for i in lanes_of(missed) {
             let dir = paths.d.lane(i);
             let (le, pdf) = e.eval_pdf(dir);
@@ -1033,6 +1048,22 @@ impl<'s> Kernel<'s> {
                     }
                     pdf_light = merge(ok, S::one(), pdf_light);
                     delta |= ok;
+                    sampled |= ok;
+                }
+                Light::Environment(Environment::Map(map)) if map.serves_lanes::<G>() => {
+                    let s = map.sample_lanes::<G>(conv(u0), conv(u1), m);
+                    let ok = group & set_of(s.drawn);
+                    let m = mask::<G>(ok);
+                    // Ray::spawn: offset along the normal, the direction made unit.
+                    let o = offset_origin_lanes(hl.p, hl.ng, s.direction);
+                    wi = LVec3::select(m, s.direction, wi);
+                    shadow_o = LVec3::select(m, o, shadow_o);
+                    shadow_d = LVec3::select(m, s.direction.normalize(), shadow_d);
+                    shadow_t = G::select(m, G::splat(f64::INFINITY), shadow_t);
+                    for (le, &radiance) in le.iter_mut().zip(&s.radiance) {
+                        *le = merge(ok, conv(radiance), *le);
+                    }
+                    pdf_light = merge(ok, conv(s.pdf), pdf_light);
                     sampled |= ok;
                 }
                 light => {

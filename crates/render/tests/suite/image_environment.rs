@@ -3,6 +3,7 @@
 
 use std::f64::consts::PI;
 
+use facette_bsdf::lanes::{F32x8, M32x8, Mask, Real};
 use facette_bsdf::math::rng::{Pcg32, RandomSource};
 use facette_bsdf::validation::chi2::expected_probabilities;
 use facette_bsdf::validation::{chi2_test, Chi2Config, SphereMap};
@@ -259,6 +260,78 @@ fn sampler_matches_pdf_chi_square_on_a_one_degree_sun() {
         21
     ));
     assert!(chi2_env(&env, &SphereMap::standard(), 1_000_000, 22));
+}
+
+/// A lane sampler's draw for `u`, put in a lane chosen by `rng` among eight lanes drawing
+/// other numbers (so that every lane position is exercised): its direction and the
+/// radiance and density it reports.
+fn f32_lane_draw(env: &EnvironmentMap, rng: &mut Pcg32) -> Option<(DVec3, Spectrum, f64)> {
+    let lane = (rng.next_f64() * 8.0) as usize;
+    let (mut u0, mut u1) = ([0.0f64; 8], [0.0f64; 8]);
+    for i in 0..8 {
+        (u0[i], u1[i]) = (rng.next_f64(), rng.next_f64());
+    }
+    let set = M32x8::from_fn(|i| i != (lane + 3) % 8);
+    let s = env.sample_lanes(F32x8::from_fn(|i| u0[i]), F32x8::from_fn(|i| u1[i]), set);
+    assert!(
+        !s.drawn.lane((lane + 3) % 8),
+        "a lane outside the set was drawn"
+    );
+    s.drawn.lane(lane).then(|| {
+        let r = s.radiance;
+        (
+            s.direction.lane(lane),
+            Spectrum::rgb(r[0].lane(lane), r[1].lane(lane), r[2].lane(lane)),
+            s.pdf.lane(lane),
+        )
+    })
+}
+
+/// The f32 lane sampler of the render kernel (the same source as `sample`, in f32 lanes)
+/// against the f64 density: chi-square on the whole sphere and zoomed on a 1° sun, and each
+/// draw's radiance and density those of `eval` and `pdf` at its direction within f32
+/// rounding.
+#[test]
+fn f32_lane_sampler_matches_pdf_chi_square() {
+    let (img, sun) = one_degree_sun();
+    let env = EnvironmentMap::new(img, rotation(), 1.0).unwrap();
+    assert!(env.serves_lanes::<F32x8>());
+    let sun = rotation() * sun;
+    for (map, seed) in [
+        (SphereMap::standard(), 31),
+        (SphereMap::new(sun, 1f64.to_radians()), 32),
+    ] {
+        let cfg = Chi2Config {
+            samples: 1_000_000,
+            seed,
+            ..Default::default()
+        };
+        let out = chi2_test(
+            &map,
+            &cfg,
+            |rng| f32_lane_draw(&env, rng).map(|d| d.0),
+            |d| env.pdf(d),
+        );
+        println!("{}", out.summary());
+        assert!(out.passes(0.01), "{}", out.summary());
+    }
+    let mut rng = Pcg32::new(33, 0);
+    let mut worst: [f64; 2] = [0.0; 2];
+    for _ in 0..100_000 {
+        let (d, radiance, pdf) = f32_lane_draw(&env, &mut rng).expect("a sky draws every lane");
+        assert!((d.length() - 1.0).abs() < 1e-6);
+        let (want_radiance, want_pdf) = env.eval_pdf(d);
+        assert!(pdf > 0.0 && radiance.is_finite());
+        worst[0] = worst[0].max((pdf / want_pdf - 1.0).abs());
+        for c in 0..3 {
+            worst[1] = worst[1].max((radiance[c] / want_radiance[c] - 1.0).abs());
+        }
+    }
+    println!(
+        "largest relative differences: pdf {:e}, radiance {:e}",
+        worst[0], worst[1]
+    );
+    assert!(worst[0] < 1e-3 && worst[1] < 1e-3, "{worst:?}");
 }
 
 /// The sampler this map had before the bilinear one, rebuilt as the baseline: per pixel,
