@@ -23,7 +23,13 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     if !(x.abs() < REDUCTION_LIMIT) {
         return x.sin_cos();
     }
-    let k = (x * std::f64::consts::FRAC_2_PI).round();
+    // k = x·2/π rounded to the nearest integer by adding and subtracting 1.5·2⁵², not by
+    // `round`: that is a C library call in code built for the baseline x86-64 (no SSE4.1
+    // `roundsd`), and one in the environment map's sampler cost as much as the polynomials.
+    // Exact for |x·2/π| < 2⁵¹ (here below 2²⁰); a tie rounds to even, and either
+    // neighbour leaves |r| ≤ π/4.
+    const ROUNDER: f64 = 6_755_399_441_055_744.0; // 1.5 · 2⁵²
+    let k = (x * std::f64::consts::FRAC_2_PI + ROUNDER) - ROUNDER;
     let r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
     let (s, c) = (kernel_sin(r), kernel_cos(r));
     // Quadrant q = k mod 4: (sin, cos) of r + qπ/2, without a branch on q (random angles
