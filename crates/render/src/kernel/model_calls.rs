@@ -7,12 +7,16 @@
 //! predecessor walks, MemorySSA renaming), which grow faster than linearly with it, kept the
 //! render crate's test build busy for over 30 minutes on one core. Here each model call is
 //! one function per lane type, compiled for AVX2 + FMA where the CPU has them: a call per
-//! model group and bounce, nothing next to the model's own work.
+//! model group and bounce, nothing next to the model's own work. The environment map's
+//! lane look-up and sampler are called the same way, so that the kernel's function does
+//! not grow by their code in scenes without a map.
 
 use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LVec3, Real, U32x8};
 #[cfg(target_arch = "x86_64")]
 use facette_bsdf::lanes::{F32x8Avx2, U32x8Avx2};
 use facette_bsdf::models::{ColorSource, LaneBsdf, LaneRandom, LaneSample};
+
+use crate::image::environment::{EnvSampleLanes, EnvironmentMap};
 
 /// A lane type the kernel shades with, and how it calls the lane models: by default their
 /// baseline out-of-line functions.
@@ -44,6 +48,23 @@ pub(crate) trait ShadingLanes: Real {
         rng: &mut impl LaneRandom<Self>,
     ) -> LaneSample<Self> {
         model.sample_out_of_line(colors, wo, u_lobe, u0, u1, rng)
+    }
+
+    /// [`EnvironmentMap::eval_pdf_lanes`].
+    #[inline(always)]
+    fn eval_environment(map: &EnvironmentMap, d: LVec3<Self>) -> ([Self; 3], Self) {
+        map.eval_pdf_lanes(d)
+    }
+
+    /// [`EnvironmentMap::sample_lanes`].
+    #[inline(always)]
+    fn sample_environment(
+        map: &EnvironmentMap,
+        u0: Self,
+        u1: Self,
+        set: Self::Mask,
+    ) -> EnvSampleLanes<Self> {
+        map.sample_lanes(u0, u1, set)
     }
 }
 
@@ -89,6 +110,42 @@ impl ShadingLanes for F32x8Avx2 {
         // SAFETY: as in `eval_pdf`.
         unsafe { sample_avx2(model, colors, wo, u_lobe, u0, u1, rng) }
     }
+
+    #[inline(always)]
+    fn eval_environment(map: &EnvironmentMap, d: LVec3<Self>) -> ([Self; 3], Self) {
+        // SAFETY: as in `eval_pdf`.
+        unsafe { eval_environment_avx2(map, d) }
+    }
+
+    #[inline(always)]
+    fn sample_environment(
+        map: &EnvironmentMap,
+        u0: Self,
+        u1: Self,
+        set: Self::Mask,
+    ) -> EnvSampleLanes<Self> {
+        // SAFETY: as in `eval_pdf`.
+        unsafe { sample_environment_avx2(map, u0, u1, set) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+fn eval_environment_avx2(map: &EnvironmentMap, d: LVec3<F32x8Avx2>) -> ([F32x8Avx2; 3], F32x8Avx2) {
+    map.eval_pdf_lanes(d)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+fn sample_environment_avx2(
+    map: &EnvironmentMap,
+    u0: F32x8Avx2,
+    u1: F32x8Avx2,
+    set: <F32x8Avx2 as Real>::Mask,
+) -> EnvSampleLanes<F32x8Avx2> {
+    map.sample_lanes(u0, u1, set)
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -863,7 +863,7 @@ impl<'s> Kernel<'s> {
 
     /// Emission seen by the rays of `missed` leaving the scene.
     #[inline(always)]
-    fn environment<S: Real, G: Real>(&self, paths: &mut Paths<S, G>, missed: Lanes) {
+    fn environment<S: ShadingLanes, G: Real>(&self, paths: &mut Paths<S, G>, missed: Lanes) {
         let scene = self.scene;
         let Some(env) = scene.environment else { return };
         let Light::Environment(e) = &scene.lights[env as usize] else {
@@ -883,14 +883,13 @@ impl<'s> Kernel<'s> {
             return;
         }
         if let Environment::Map(map) = e {
-            if map.serves_lanes::<G>() {
+            if map.serves_lanes::<S>() {
                 // Every lane's look-up at once; the black ones (zero luminance) add nothing.
-                let (le, pdf) = map.eval_pdf_lanes(paths.d);
-                let lit = le[0].gt(G::zero()) | le[1].gt(G::zero()) | le[2].gt(G::zero());
+                let (le, pdf) = S::eval_environment(map, conv_vec::<G, S>(paths.d));
+                let lit = le[0].gt(S::zero()) | le[1].gt(S::zero()) | le[2].gt(S::zero());
                 let set = missed & set_of(lit);
                 if set != 0 {
-                    let le: Rgb<S> = [conv(le[0]), conv(le[1]), conv(le[2])];
-                    let pl = S::splat(p_select) * conv::<G, S>(pdf);
+                    let pl = S::splat(p_select) * pdf;
                     let w = self.emission_weight(paths.delta_prev, paths.prev_pdf, pl);
                     Self::add_radiance(paths, set, &le, w);
                 }
@@ -1050,20 +1049,21 @@ impl<'s> Kernel<'s> {
                     delta |= ok;
                     sampled |= ok;
                 }
-                Light::Environment(Environment::Map(map)) if map.serves_lanes::<G>() => {
-                    let s = map.sample_lanes::<G>(conv(u0), conv(u1), m);
+                Light::Environment(Environment::Map(map)) if map.serves_lanes::<S>() => {
+                    let s = S::sample_environment(map, u0, u1, mask::<S>(group));
                     let ok = group & set_of(s.drawn);
                     let m = mask::<G>(ok);
+                    let dir = conv_vec::<S, G>(s.direction);
                     // Ray::spawn: offset along the normal, the direction made unit.
-                    let o = offset_origin_lanes(hl.p, hl.ng, s.direction);
-                    wi = LVec3::select(m, s.direction, wi);
+                    let o = offset_origin_lanes(hl.p, hl.ng, dir);
+                    wi = LVec3::select(m, dir, wi);
                     shadow_o = LVec3::select(m, o, shadow_o);
-                    shadow_d = LVec3::select(m, s.direction.normalize(), shadow_d);
+                    shadow_d = LVec3::select(m, dir.normalize(), shadow_d);
                     shadow_t = G::select(m, G::splat(f64::INFINITY), shadow_t);
                     for (le, &radiance) in le.iter_mut().zip(&s.radiance) {
-                        *le = merge(ok, conv(radiance), *le);
+                        *le = merge(ok, radiance, *le);
                     }
-                    pdf_light = merge(ok, conv(s.pdf), pdf_light);
+                    pdf_light = merge(ok, s.pdf, pdf_light);
                     sampled |= ok;
                 }
                 light => {
