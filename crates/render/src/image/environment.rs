@@ -50,6 +50,21 @@
 //! per-sample variance to 4 digits; the gain is exactness, not variance.) `sample` returns
 //! `eval` and `pdf` of the very direction it produces.
 //!
+//! **Lanes** — `eval`, `pdf` and `sample` are written once over the lane trait
+//! ([`Real`]): the f64 methods are its one-lane instantiation, and the render kernel runs
+//! it on eight f32 lanes (`eval_pdf_lanes` for rays leaving the scene, `sample_lanes` for
+//! light samples). A sample's patch is drawn lane by lane from the f64 CDFs (the guided
+//! search is a table look-up, and an f32 CDF would lose patches of mass below 2⁻²⁴); the
+//! point inside the patch, its direction and the bilinear look-ups of its radiance and
+//! density run in the lanes. The f32 Newton inversion stops at its precision's tolerances
+//! (residual 1e-6 of the row's mass, step 1e-5, bracket 1e-6; f64 keeps 1e-14, 1e-10 and
+//! 1e-15). Against the f64 `pdf` of the directions they draw, the f32 lanes' densities and
+//! radiance are within 5.1e-4 relative on the default 1° sun (steep edges, where an f32
+//! direction moves the bilinear look-up by 1e-4 pixel), and their draws pass the
+//! chi-square test against the f64 density, on the sphere and zoomed on the sun (tested).
+//! A map of more than 2²⁴ pixels (an f32 lane indexes a texel exactly only below that) is
+//! sampled lane by lane in f64.
+//!
 //! Negative and non-finite pixel values are stored as 0 (radiance is non-negative).
 
 use std::f64::consts::{FRAC_1_PI, PI};

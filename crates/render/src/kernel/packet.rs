@@ -16,7 +16,10 @@
 //! functions as the scalar integrator's (the sphere test and record, the camera, the
 //! spawning rule with the offset of the lanes' precision, the frame) — and the shading —
 //! the directions in the local frame, the materials that have a lane model
-//! ([`LaneBsdf`](facette_bsdf::models::LaneBsdf)), light and path weights. In f64 lanes a
+//! ([`LaneBsdf`](facette_bsdf::models::LaneBsdf)), environment maps (the radiance and
+//! density of rays leaving the scene and the map's light samples,
+//! [`EnvironmentMap::sample_lanes`](crate::image::EnvironmentMap::sample_lanes)), light and
+//! path weights. In f64 lanes a
 //! ray hits what the scalar integrator's ray hits, bit for bit; in f32 lanes it hits the
 //! same surfaces up to f32 rounding (shapes without a lane test are tested in f64 on the
 //! lane's f32 ray). The random numbers are the scalar integrator's, dimension for
@@ -28,8 +31,9 @@
 //!
 //! What has no lane form runs lane by lane inside the same step, through the scalar code:
 //! materials without a lane model (and glints) through their
-//! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than a constant environment and point
-//! lights, environment maps, area-light emission, ray differentials. On x86-64 the kernel
+//! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than environments and point lights (and
+//! maps of more than 2²⁴ pixels, which an f32 lane cannot index), area-light emission, ray
+//! differentials. On x86-64 the kernel
 //! is compiled twice, for the baseline (SSE2: an 8-lane f32 operation is two instructions)
 //! and for AVX2 + FMA with the register lanes, chosen at run time; the two give the same
 //! image bit for bit (tested).
