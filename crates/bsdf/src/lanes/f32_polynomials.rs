@@ -75,8 +75,9 @@ pub fn sin_cos<L: F32Lanes>(x: L) -> (L, L) {
 /// atan2(y, x) from Cephes `atanf` (its polynomial on [−tan π/8, tan π/8], about 2e-7
 /// relative) applied to r = min(|x|, |y|) / max(|x|, |y|) ∈ [0, 1], reduced above tan π/8 by
 /// atan r = π/4 + atan((r − 1)/(r + 1)); then the octant (π/2 − a where |y| > |x|, π − a
-/// where x < 0) and the sign of y. atan2(±0, ±0) is ±0 (not ±π for x = −0); within 3e-7
-/// absolute of the f64 function (tested).
+/// where x has its sign bit set, as libm: atan2(±0, −0) = ±π) and the sign of y; within
+/// 3e-7 absolute of the f64 function (tested). Unlike libm, atan2(±∞, ±∞) and a NaN x give
+/// NaN and a NaN y gives ±0 (the renderer passes finite directions).
 #[inline(always)]
 pub fn atan2<L: F32Lanes>(y: L, x: L) -> L {
     use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
@@ -95,8 +96,9 @@ pub fn atan2<L: F32Lanes>(y: L, x: L) -> L {
         + t;
     let a = p + L::select(reduce, L::splat(FRAC_PI_4), L::zero());
     let a = L::select(ay.gt(ax), L::splat(FRAC_PI_2) - a, a);
-    let a = L::select(x.lt(L::zero()), L::splat(PI) - a, a);
     let sign = L::Bits::splat(0x8000_0000);
+    let x_negative = L::mask_from_bits(L::Bits::splat(0).wrapping_sub(x.to_bits().shr(31)));
+    let a = L::select(x_negative, L::splat(PI) - a, a);
     L::from_bits(a.to_bits() ^ (y.to_bits() & sign))
 }
 

@@ -62,8 +62,10 @@
 //! radiance are within 5.1e-4 relative on the default 1° sun (steep edges, where an f32
 //! direction moves the bilinear look-up by 1e-4 pixel), and their draws pass the
 //! chi-square test against the f64 density, on the sphere and zoomed on the sun (tested).
-//! A map of more than 2²⁴ pixels (an f32 lane indexes a texel exactly only below that) is
-//! sampled lane by lane in f64.
+//! A map of more than 2²⁴ pixels (an f32 lane indexes a texel exactly only up to that), or
+//! whose largest value, radiance or density scale lies outside [1e-15, 1e15] (where f32
+//! squares and products would leave the normal range), is sampled lane by lane in f64
+//! ([`EnvironmentMap::serves_lanes`]).
 //!
 //! Negative and non-finite pixel values are stored as 0 (radiance is non-negative).
 
@@ -395,6 +397,8 @@ pub struct EnvironmentMap {
     distribution: Distribution2D,
     /// 1 / (2π² Σ weights) = 1 / ∫Y dω (unscaled); 0 for a black map.
     inv_integral: f64,
+    /// The largest pixel luminance or channel (unscaled).
+    brightest: f64,
     /// What the points of each patch row share ([`PatchRow`]).
     row_angles: Vec<RowAngles<f64>>,
     mean: Spectrum,
@@ -517,7 +521,13 @@ impl EnvironmentMap {
                 })
                 .collect(),
         );
+        let brightest = texels
+            .f64_cells()
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, &v| m.max(v));
         Ok(EnvironmentMap {
+            brightest,
             texels,
             image,
             to_world,
@@ -582,10 +592,20 @@ impl EnvironmentMap {
         self.to_world * uv_to_direction(uv)
     }
 
-    /// Whether [`eval_pdf_lanes`](Self::eval_pdf_lanes) serves lanes of type `R`: a cell is
-    /// indexed by a lane, which holds every integer below 2^digits exactly.
+    /// Whether [`eval_pdf_lanes`](Self::eval_pdf_lanes) and
+    /// [`sample_lanes`](Self::sample_lanes) serve lanes of type `R`: a cell is indexed by a
+    /// lane, exact for indices up to 2^digits, and in f32 lanes the luminances, their
+    /// squares (the linear inversion), the radiance and the density's scale must be normal
+    /// f32 numbers — true of any map in ordinary units; the others are sampled in f64 lane
+    /// by lane.
     pub fn serves_lanes<R: Real>(&self) -> bool {
-        self.texels.len() as f64 <= 2f64.powi(R::DIGITS as i32)
+        let indexed = self.texels.len() as f64 <= 2f64.powi(R::DIGITS as i32);
+        let in_range = |v: f64| v == 0.0 || (1e-15..=1e15).contains(&v);
+        indexed
+            && (R::DIGITS > 24
+                || (in_range(self.brightest)
+                    && in_range(self.brightest * self.scale)
+                    && in_range(self.inv_integral)))
     }
 
     /// Radiance (times `scale`) and density at texture coordinates (u, v) ∈ [0, 1)² in
@@ -951,6 +971,22 @@ mod tests {
                 "{a} {c}: {m0} vs {r0}"
             );
         }
+    }
+
+    /// f32 lanes serve maps whose luminances, their squares and the density's scale are
+    /// normal f32 numbers; the others (and every map, in f64 lanes) are served in f64.
+    #[test]
+    fn f32_lanes_serve_maps_in_ordinary_units() {
+        use facette_bsdf::lanes::F32x8;
+        let map = |v: f32, scale: f64| {
+            let img = RgbImage::from_fn(8, 4, |x, _| [v * (x + 1) as f32; 3]).unwrap();
+            EnvironmentMap::new(img, DMat3::IDENTITY, scale).unwrap()
+        };
+        assert!(map(1.0, 1.0).serves_lanes::<F32x8>());
+        assert!(map(1e-3, 1e3).serves_lanes::<F32x8>());
+        assert!(!map(1e20, 1e-6).serves_lanes::<F32x8>());
+        assert!(!map(1e-20, 1.0).serves_lanes::<F32x8>());
+        assert!(map(1e20, 1e-6).serves_lanes::<f64>() && map(1e-20, 1.0).serves_lanes::<f64>());
     }
 
     #[test]

@@ -8,8 +8,9 @@
 //! render crate's test build busy for over 30 minutes on one core. Here each model call is
 //! one function per lane type, compiled for AVX2 + FMA where the CPU has them: a call per
 //! model group and bounce, nothing next to the model's own work. The environment map's
-//! lane look-up and sampler are called the same way, so that the kernel's function does
-//! not grow by their code in scenes without a map.
+//! lane look-up and sampler are called the same way, in every build: inlined into the
+//! kernel's function they made the render crate's builds much slower (its test build
+//! about twice as long).
 
 use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LVec3, Real, U32x8};
 #[cfg(target_arch = "x86_64")]
@@ -50,13 +51,13 @@ pub(crate) trait ShadingLanes: Real {
         model.sample_out_of_line(colors, wo, u_lobe, u0, u1, rng)
     }
 
-    /// [`EnvironmentMap::eval_pdf_lanes`].
+    /// [`EnvironmentMap::eval_pdf_lanes`], out of line.
     #[inline(always)]
     fn eval_environment(map: &EnvironmentMap, d: LVec3<Self>) -> ([Self; 3], Self) {
-        map.eval_pdf_lanes(d)
+        eval_environment_out_of_line(map, d)
     }
 
-    /// [`EnvironmentMap::sample_lanes`].
+    /// [`EnvironmentMap::sample_lanes`], out of line.
     #[inline(always)]
     fn sample_environment(
         map: &EnvironmentMap,
@@ -64,8 +65,26 @@ pub(crate) trait ShadingLanes: Real {
         u1: Self,
         set: Self::Mask,
     ) -> EnvSampleLanes<Self> {
-        map.sample_lanes(u0, u1, set)
+        sample_environment_out_of_line(map, u0, u1, set)
     }
+}
+
+/// The baseline builds' environment look-up, a function of its own (inlined, the map's code
+/// in the kernel's function doubled the render crate's test build time).
+#[inline(never)]
+fn eval_environment_out_of_line<R: Real>(map: &EnvironmentMap, d: LVec3<R>) -> ([R; 3], R) {
+    map.eval_pdf_lanes(d)
+}
+
+/// The baseline builds' environment sampler, a function of its own.
+#[inline(never)]
+fn sample_environment_out_of_line<R: Real>(
+    map: &EnvironmentMap,
+    u0: R,
+    u1: R,
+    set: R::Mask,
+) -> EnvSampleLanes<R> {
+    map.sample_lanes(u0, u1, set)
 }
 
 /// f64 lanes (the test that finds the scalar integrator's image): the baseline build.

@@ -1055,7 +1055,10 @@ impl<'s> Kernel<'s> {
                 }
                 Light::Environment(Environment::Map(map)) if map.serves_lanes::<S>() => {
                     let s = S::sample_environment(map, u0, u1, mask::<S>(group));
-                    let ok = group & set_of(s.drawn);
+                    let [r, g, b] = s.radiance;
+                    // A map of scale 0 has density but no radiance: no shadow ray for it.
+                    let lit = r.gt(S::zero()) | g.gt(S::zero()) | b.gt(S::zero());
+                    let ok = group & set_of(s.drawn & lit);
                     let m = mask::<G>(ok);
                     let dir = conv_vec::<S, G>(s.direction);
                     // Ray::spawn: offset along the normal, the direction made unit.
