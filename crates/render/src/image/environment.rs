@@ -414,10 +414,18 @@ fn patch_row(j: usize, h: usize) -> (usize, usize, f64, f64) {
     (j.saturating_sub(1), j.min(h - 1), v0, v1 - v0)
 }
 
-/// A vector's three coordinates in every lane.
+/// `m v` in lanes, with glam's order of the product's sums (so that f64 lanes give glam's
+/// `DMat3 * DVec3` to the bit).
 #[inline(always)]
-fn splat_vec<R: Real>(c: DVec3) -> LVec3<R> {
-    LVec3::new(R::splat(c.x), R::splat(c.y), R::splat(c.z))
+fn rotate_lanes<R: Real>(m: &DMat3, v: LVec3<R>) -> LVec3<R> {
+    // A function, not a closure, so that it inlines into the AVX2 build's code.
+    #[inline(always)]
+    fn column<R: Real>(c: DVec3) -> LVec3<R> {
+        LVec3::new(R::splat(c.x), R::splat(c.y), R::splat(c.z))
+    }
+    column::<R>(m.x_axis).scale(v.x)
+        + column::<R>(m.y_axis).scale(v.y)
+        + column::<R>(m.z_axis).scale(v.z)
 }
 
 /// Luminance of a stored (non-negative) pixel.
@@ -573,11 +581,8 @@ impl EnvironmentMap {
     /// (the others hold the coordinates of the map's +y).
     #[inline(always)]
     pub fn uv_lanes<R: Real>(&self, d: LVec3<R>) -> (R::Mask, R, R) {
-        let m = &self.to_local;
-        // glam's order of the product's sums, and its `length` and division.
-        let v = splat_vec::<R>(m.x_axis).scale(d.x)
-            + splat_vec::<R>(m.y_axis).scale(d.y)
-            + splat_vec::<R>(m.z_axis).scale(d.z);
+        // glam's product, `length` and division.
+        let v = rotate_lanes(&self.to_local, d);
         let len = v.length_squared().sqrt();
         let ok = len.gt(R::zero()) & len.is_finite();
         let unit = LVec3::new(v.x / len, v.y / len, v.z / len);
@@ -797,11 +802,7 @@ impl EnvironmentMap {
         uu = R::select(uu.ge(R::one()), uu - R::one(), uu);
         let vv = (v0 + dv * t).min(R::one());
         let local = uv_to_direction_lanes(uu, vv);
-        let m = &self.to_world;
-        let direction = (splat_vec::<R>(m.x_axis).scale(local.x)
-            + splat_vec::<R>(m.y_axis).scale(local.y)
-            + splat_vec::<R>(m.z_axis).scale(local.z))
-        .normalize();
+        let direction = rotate_lanes(&self.to_world, local).normalize();
         let (radiance, pdf) = self.eval_pdf_lanes(direction);
         EnvSampleLanes {
             drawn: R::Mask::splat(true),
