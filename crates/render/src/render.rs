@@ -112,15 +112,28 @@ impl PixelSums {
     /// left out.
     #[inline]
     pub(crate) fn add(&mut self, l: Spectrum) {
-        self.n += 1;
         if l.is_finite() && !l.has_negative() {
-            for c in 0..3 {
-                self.sum[c] += l[c];
-                self.sq[c] += l[c] * l[c];
-            }
+            self.add_valid(l);
         } else {
-            self.bad += 1;
+            self.add_invalid();
         }
+    }
+
+    /// Adds one camera sample's radiance, known to be finite and not negative.
+    #[inline(always)]
+    pub(crate) fn add_valid(&mut self, l: Spectrum) {
+        self.n += 1;
+        for c in 0..3 {
+            self.sum[c] += l[c];
+            self.sq[c] += l[c] * l[c];
+        }
+    }
+
+    /// Counts one camera sample whose radiance is non-finite or negative.
+    #[inline(always)]
+    pub(crate) fn add_invalid(&mut self) {
+        self.n += 1;
+        self.bad += 1;
     }
 }
 

@@ -207,6 +207,16 @@ impl Real for F32x8Avx2 {
                 .write(v as f32)
         }
     }
+    /// One `vpermps`.
+    #[inline(always)]
+    fn permute(self, from: &[u8; 8]) -> Self {
+        // SAFETY: `from` is 8 readable bytes; every lane index is masked to 0..8 by the
+        // instruction.
+        F32x8Avx2(unsafe {
+            let idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(from.as_ptr() as *const __m128i));
+            _mm256_permutevar8x32_ps(self.0, idx)
+        })
+    }
     #[inline(always)]
     fn sqrt(self) -> Self {
         F32x8Avx2(unsafe { _mm256_sqrt_ps(self.0) })
@@ -357,6 +367,26 @@ impl Bits32 for U32x8Avx2 {
             *v = f(i);
         }
         Self::from_array(a)
+    }
+    /// One `vpermd`.
+    #[inline(always)]
+    fn permute(self, from: &[u8; 8]) -> Self {
+        // SAFETY: `from` is 8 readable bytes; the instruction masks each index to 0..8.
+        U32x8Avx2(unsafe {
+            let idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(from.as_ptr() as *const __m128i));
+            _mm256_permutevar8x32_epi32(self.0, idx)
+        })
+    }
+    #[inline(always)]
+    fn blend_bits(set: u8, a: Self, b: Self) -> Self {
+        U32x8Avx2(unsafe {
+            let lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let m = _mm256_cmpeq_epi32(
+                _mm256_and_si256(_mm256_set1_epi32(set as i32), lane_bit),
+                lane_bit,
+            );
+            _mm256_blendv_epi8(b.0, a.0, m)
+        })
     }
     #[inline(always)]
     fn wrapping_add(self, o: Self) -> Self {
@@ -590,6 +620,38 @@ mod tests {
             );
             let f64s: [f64; 8] = std::array::from_fn(|i| a.unit::<crate::lanes::F64x8>().0[i]);
             assert_eq!(f64s, p.unit::<crate::lanes::F64x8>().0);
+        }
+    }
+
+    /// The permutations and the bit-mask blend move the same lanes as the array lanes' (and
+    /// as the definition: lane i takes lane from[i]), with repeated and identity indices.
+    #[test]
+    fn register_permutes_and_blends_move_the_array_lanes() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let x: [u32; 8] = [11, 22, 33, 44, 55, 66, 77, 88];
+        let y: [u32; 8] = [1, 2, 3, 4, 5, 6, 7, 8];
+        let f = x.map(|v| v as f32 * 0.5);
+        for from in [
+            [0u8, 1, 2, 3, 4, 5, 6, 7],
+            [7, 6, 5, 4, 3, 2, 1, 0],
+            [3, 3, 0, 7, 1, 1, 6, 2],
+        ] {
+            let want: [u32; 8] = std::array::from_fn(|i| x[from[i] as usize]);
+            assert_eq!(U32x8(x).permute(&from).0, want);
+            assert_eq!(U32x8Avx2::from_array(x).permute(&from).to_array(), want);
+            let wantf: [f32; 8] = std::array::from_fn(|i| f[from[i] as usize]);
+            assert_eq!(F32x8(f).permute(&from).0, wantf);
+            assert_eq!(F32x8Avx2::from_array(f).permute(&from).to_array(), wantf);
+        }
+        for set in [0u8, 0xff, 0b1010_0110, 0b0000_0001, 0b1000_0000] {
+            let want: [u32; 8] =
+                std::array::from_fn(|i| if (set >> i) & 1 != 0 { x[i] } else { y[i] });
+            assert_eq!(U32x8::blend_bits(set, U32x8(x), U32x8(y)).0, want);
+            let p = U32x8Avx2::blend_bits(set, U32x8Avx2::from_array(x), U32x8Avx2::from_array(y));
+            assert_eq!(p.to_array(), want, "set {set:08b}");
         }
     }
 

@@ -94,6 +94,14 @@ pub trait Real:
         *self = Self::from_fn(|j| if j == i { v } else { old.lane(j) });
     }
 
+    /// Lane `i` takes lane `from[i]` of `self` (each index below `LANES`; the first
+    /// `LANES` entries are read): the render kernel's refill moves camera rays into the
+    /// free lanes of its paths with it.
+    #[inline(always)]
+    fn permute(self, from: &[u8; 8]) -> Self {
+        Self::from_fn(|i| self.lane(from[i] as usize))
+    }
+
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
     fn min(self, o: Self) -> Self;

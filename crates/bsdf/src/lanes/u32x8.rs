@@ -29,6 +29,24 @@ pub trait Bits32:
     /// Whether every lane is below `n`.
     fn all_below(self, n: u32) -> bool;
 
+    /// Lane `i` takes lane `from[i]` of `self` (each index below `LANES`; the first
+    /// `LANES` entries are read).
+    #[inline(always)]
+    fn permute(self, from: &[u8; 8]) -> Self {
+        Self::from_fn(|i| self.lane(from[i] as usize))
+    }
+    /// Lane `i` of `a` where bit `i` of `set` is 1, else lane `i` of `b`.
+    #[inline(always)]
+    fn blend_bits(set: u8, a: Self, b: Self) -> Self {
+        Self::from_fn(|i| {
+            if (set >> i) & 1 != 0 {
+                a.lane(i)
+            } else {
+                b.lane(i)
+            }
+        })
+    }
+
     /// The bits in reverse order: five swaps of ever smaller fields (the branch-free
     /// reversal, which vectorizes; `u32::reverse_bits` is one instruction only on ARM).
     #[inline(always)]

@@ -78,6 +78,15 @@ impl<R: Real> LVec3<R> {
             R::select(m, a.z, b.z),
         )
     }
+    /// Lane `i` takes lane `from[i]` ([`Real::permute`]).
+    #[inline(always)]
+    pub fn permute(self, from: &[u8; 8]) -> Self {
+        LVec3::new(
+            self.x.permute(from),
+            self.y.permute(from),
+            self.z.permute(from),
+        )
+    }
 }
 
 impl<R: Real> Add for LVec3<R> {

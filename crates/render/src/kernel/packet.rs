@@ -84,6 +84,20 @@ fn mask<R: Real>(set: Lanes) -> R::Mask {
     R::Mask::from_lane_bits(set as u32)
 }
 
+/// The lanes `i` of `set` in `dst` take lane `from[i]` of `src`: one permutation and blend.
+#[inline(always)]
+fn move_lanes<B: Bits32>(
+    dst: &mut [u32; LANES],
+    src: &[u32; LANES],
+    from: &[u8; LANES],
+    set: Lanes,
+) {
+    let moved = B::from_fn(|i| src[i]).permute(from);
+    let kept = B::from_fn(|i| dst[i]);
+    let v = B::blend_bits(set, moved, kept);
+    *dst = std::array::from_fn(|i| v.lane(i));
+}
+
 /// The lane set of a mask of 8 lanes.
 #[inline(always)]
 fn set_of<M: Mask>(m: M) -> Lanes {
@@ -190,7 +204,9 @@ struct CameraBatch<G: Real> {
 struct LaneStreams {
     streams: [SampleStream; LANES],
     /// Each lane's camera sample: pixel x, y and sample number.
-    of: [(usize, usize, u64); LANES],
+    x: [u32; LANES],
+    y: [u32; LANES],
+    sample: [u32; LANES],
     /// The lanes whose stream is made.
     made: Lanes,
 }
@@ -199,28 +215,46 @@ impl LaneStreams {
     fn new(sampler: &PixelSampler) -> Self {
         LaneStreams {
             streams: std::array::from_fn(|_| sampler.stream(0, 0, 0)),
-            of: [(0, 0, 0); LANES],
+            x: [0; LANES],
+            y: [0; LANES],
+            sample: [0; LANES],
             made: 0,
         }
     }
 
-    /// Lane `i` holds camera sample `sample` of pixel (x, y); its stream is not made.
+    /// The first `n` lanes hold the camera samples of `jobs`; their streams are not made.
     #[inline(always)]
-    fn assign(&mut self, i: usize, of: (usize, usize, u64)) {
-        self.of[i] = of;
-        self.made &= !(1 << i);
+    fn assign(&mut self, jobs: &JobLanes, n: usize) {
+        self.x = std::array::from_fn(|i| jobs.x[i] as u32);
+        self.y = std::array::from_fn(|i| jobs.y[i] as u32);
+        self.sample = std::array::from_fn(|i| jobs.sample[i] as u32);
+        self.made &= !(((1u32 << n) - 1) as Lanes);
     }
 
-    /// Lane `i` of `self` takes lane `j` of `from` (its stream too, where made).
+    /// The lanes `i` of `set` take lane `src[i]` of `from` (their streams too, where made);
+    /// `taken` is the set of those lanes of `from`. Only the camera sample is copied in the
+    /// common case, where no stream of `from` is made.
     #[inline(always)]
-    fn take(&mut self, i: usize, from: &mut LaneStreams, j: usize) {
-        self.of[i] = from.of[j];
-        if from.made & (1 << j) != 0 {
-            std::mem::swap(&mut self.streams[i], &mut from.streams[j]);
-            from.made &= !(1 << j);
-            self.made |= 1 << i;
-        } else {
-            self.made &= !(1 << i);
+    fn take<B: Bits32>(
+        &mut self,
+        set: Lanes,
+        from: &mut LaneStreams,
+        src: &[u8; LANES],
+        taken: Lanes,
+    ) {
+        move_lanes::<B>(&mut self.x, &from.x, src, set);
+        move_lanes::<B>(&mut self.y, &from.y, src, set);
+        move_lanes::<B>(&mut self.sample, &from.sample, src, set);
+        self.made &= !set;
+        if from.made & taken != 0 {
+            for i in lanes_of(set) {
+                let j = src[i] as usize;
+                if from.made & (1 << j) != 0 {
+                    std::mem::swap(&mut self.streams[i], &mut from.streams[j]);
+                    from.made &= !(1 << j);
+                    self.made |= 1 << i;
+                }
+            }
         }
     }
 
@@ -228,8 +262,8 @@ impl LaneStreams {
     #[inline(always)]
     fn make(&mut self, set: Lanes, sampler: &PixelSampler) {
         for i in lanes_of(set & !self.made) {
-            let (x, y, s) = self.of[i];
-            self.streams[i] = sampler.stream(x, y, s);
+            let (x, y, s) = (self.x[i], self.y[i], self.sample[i]);
+            self.streams[i] = sampler.stream(x as usize, y as usize, s as u64);
         }
         self.made |= set;
     }
@@ -254,45 +288,77 @@ struct Jobs<'a> {
     xs: Range<usize>,
     ys: Range<usize>,
     chunk: &'a [u32],
-    /// The next job: row, column, sample.
+    /// The next job: row, column, index into `chunk`, and the pixel's slot (row-major in
+    /// the tile); `k < chunk.len()`.
     y: usize,
     x: usize,
     k: usize,
+    slot: u32,
+    /// Whether the next job's row is started (its `stop` asked and counted).
+    row_started: bool,
     rows_started: usize,
     stop: &'a dyn Fn() -> bool,
     ended: bool,
 }
 
-impl Iterator for Jobs<'_> {
-    /// (x, y, sample index, slot).
-    type Item = (usize, usize, u32, u32);
-
-    #[inline(always)]
-    fn next(&mut self) -> Option<Self::Item> {
-        if self.ended || self.chunk.is_empty() || self.xs.is_empty() {
-            return None;
+impl<'a> Jobs<'a> {
+    fn new(job: &TileJob<'a>) -> Self {
+        Jobs {
+            xs: job.xs.clone(),
+            ys: job.ys.clone(),
+            chunk: job.chunk,
+            y: job.ys.start,
+            x: job.xs.start,
+            k: 0,
+            slot: 0,
+            row_started: false,
+            rows_started: 0,
+            stop: job.stop,
+            ended: job.chunk.is_empty() || job.xs.is_empty(),
         }
-        if self.k == self.chunk.len() {
-            self.k = 0;
-            self.x += 1;
-            if self.x == self.xs.end {
-                self.x = self.xs.start;
-                self.y += 1;
-            }
-        }
-        if self.x == self.xs.start && self.k == 0 {
-            // A new row.
-            if self.y >= self.ys.end || (self.stop)() {
-                self.ended = true;
-                return None;
-            }
-            self.rows_started += 1;
-        }
-        let s = self.chunk[self.k];
-        self.k += 1;
-        let slot = (self.y - self.ys.start) * self.xs.len() + (self.x - self.xs.start);
-        Some((self.x, self.y, s, slot as u32))
     }
+
+    /// The next (up to) eight jobs into `out`; returns how many (0 when none is left).
+    #[inline(always)]
+    fn next_batch(&mut self, out: &mut JobLanes) -> usize {
+        let mut n = 0;
+        while n < LANES && !self.ended {
+            if !self.row_started {
+                if self.y >= self.ys.end || (self.stop)() {
+                    self.ended = true;
+                    break;
+                }
+                self.rows_started += 1;
+                self.row_started = true;
+            }
+            out.x[n] = self.x;
+            out.y[n] = self.y;
+            out.sample[n] = self.chunk[self.k] as u64;
+            out.slot[n] = self.slot;
+            n += 1;
+            self.k += 1;
+            if self.k == self.chunk.len() {
+                self.k = 0;
+                self.x += 1;
+                self.slot += 1;
+                if self.x == self.xs.end {
+                    self.x = self.xs.start;
+                    self.y += 1;
+                    self.row_started = false;
+                }
+            }
+        }
+        n
+    }
+}
+
+/// A batch of jobs: pixel x, y, sample index and slot of each lane.
+#[derive(Default)]
+struct JobLanes {
+    x: [usize; LANES],
+    y: [usize; LANES],
+    sample: [u64; LANES],
+    slot: [u32; LANES],
 }
 
 /// What the render loop gives the kernel.
@@ -349,17 +415,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
     debug_assert_eq!(S::LANES, LANES);
     sums.clear();
     sums.resize(job.xs.len() * job.ys.len(), PixelSums::default());
-    let mut jobs = Jobs {
-        xs: job.xs.clone(),
-        ys: job.ys.clone(),
-        chunk: job.chunk,
-        y: job.ys.start,
-        x: job.xs.start,
-        k: 0,
-        rows_started: 0,
-        stop: job.stop,
-        ended: false,
-    };
+    let mut jobs = Jobs::new(job);
     let mut batch = CameraBatch::<G> {
         count: 0,
         next: 0,
@@ -511,25 +567,40 @@ impl<'s> Kernel<'s> {
         batch: &mut CameraBatch<G>,
         jobs: &mut Jobs,
     ) {
+        let mut free = !paths.live;
         let mut filled: Lanes = 0;
-        for i in 0..LANES {
-            if paths.live & (1 << i) != 0 {
-                continue;
-            }
+        // The free lanes take the batch's next rays in order, a batch at a time: the lanes'
+        // scalar state one by one, their rays by one permutation and blend per coordinate.
+        while free != 0 {
             if batch.next == batch.count && !self.make_batch::<S, G>(batch, jobs) {
                 break;
             }
-            let j = batch.next;
-            batch.next += 1;
-            paths.slot[i] = batch.slot[j];
-            paths.streams.take(i, &mut batch.streams, j);
-            paths.samples.copy_lane(i, &batch.samples, j);
-            paths.o.set_lane(i, batch.o.lane(j));
-            paths.d.set_lane(i, batch.d.lane(j));
-            if self.cameras.footprints {
-                paths.rd[i] = batch.rd[j];
+            let mut from = [0u8; LANES];
+            let mut set: Lanes = 0;
+            let first = batch.next;
+            while free != 0 && batch.next < batch.count {
+                let i = free.trailing_zeros() as usize;
+                free &= free - 1;
+                let j = batch.next;
+                batch.next += 1;
+                from[i] = j as u8;
+                set |= 1 << i;
+                if self.cameras.footprints {
+                    paths.rd[i] = batch.rd[j];
+                }
             }
-            filled |= 1 << i;
+            let taken = ((1u32 << batch.next) - (1u32 << first)) as Lanes;
+            move_lanes::<S::Bits>(&mut paths.slot, &batch.slot, &from, set);
+            paths
+                .streams
+                .take::<S::Bits>(set, &mut batch.streams, &from, taken);
+            paths
+                .samples
+                .take::<S::Bits>(set, &batch.samples, &from, taken);
+            let m = mask::<G>(set);
+            paths.o = LVec3::select(m, batch.o.permute(&from), paths.o);
+            paths.d = LVec3::select(m, batch.d.permute(&from), paths.d);
+            filled |= set;
         }
         if filled == 0 {
             return;
@@ -559,14 +630,11 @@ impl<'s> Kernel<'s> {
         batch: &mut CameraBatch<G>,
         jobs: &mut Jobs,
     ) -> bool {
-        let (mut xs, mut ys, mut ss) = ([0; LANES], [0; LANES], [0; LANES]);
-        let mut n = 0;
-        for (x, y, s, slot) in jobs.by_ref().take(LANES) {
-            batch.streams.assign(n, (x, y, s as u64));
-            (xs[n], ys[n], ss[n]) = (x, y, s as u64);
-            batch.slot[n] = slot;
-            n += 1;
-        }
+        let mut lanes = JobLanes::default();
+        let n = jobs.next_batch(&mut lanes);
+        let (xs, ys, ss, slot) = (lanes.x, lanes.y, lanes.sample, lanes.slot);
+        batch.streams.assign(&lanes, n);
+        batch.slot = slot;
         batch.count = n;
         batch.next = 0;
         if n == 0 {
@@ -640,8 +708,20 @@ impl<'s> Kernel<'s> {
     /// Ends the paths of `set`: their radiance goes to their pixels.
     #[inline(always)]
     fn finish<S: Real, G: Real>(paths: &mut Paths<S, G>, set: Lanes, sums: &mut [PixelSums]) {
+        // Which lanes' radiance is finite and not negative, for all lanes at once.
+        let ok = paths.l.iter().fold(set, |ok, c| {
+            ok & set_of(c.is_finite()) & set_of(c.ge(S::zero()))
+        });
+        // The channels as f64 arrays once, not a lane at a time.
+        let l: [[f64; LANES]; 3] =
+            std::array::from_fn(|c| std::array::from_fn(|i| paths.l[c].lane(i)));
         for i in lanes_of(set) {
-            sums[paths.slot[i] as usize].add(rgb_lane(&paths.l, i));
+            let sum = &mut sums[paths.slot[i] as usize];
+            if ok & (1 << i) != 0 {
+                sum.add_valid(Spectrum([l[0][i], l[1][i], l[2][i]]));
+            } else {
+                sum.add_invalid();
+            }
         }
         paths.live &= !set;
     }

@@ -98,12 +98,33 @@ impl SampleLanes {
         self.fast
     }
 
-    /// Lane `i` takes lane `j` of `from`.
+    /// The lanes `i` of `set` take lane `src[i]` of `from`; `taken` is the set of those
+    /// lanes of `from`.
     #[inline(always)]
-    pub(crate) fn copy_lane(&mut self, i: usize, from: &SampleLanes, j: usize) {
-        self.words[0][i] = from.words[0][j];
-        self.words[1][i] = from.words[1][j];
-        self.fast = (self.fast & !(1 << i)) | (((from.fast >> j) & 1) << i);
+    pub(crate) fn take<B: Bits32>(
+        &mut self,
+        set: u8,
+        from: &SampleLanes,
+        src: &[u8; 8],
+        taken: u8,
+    ) {
+        for (w, f) in self.words.iter_mut().zip(&from.words) {
+            let v = B::blend_bits(set, B::from_fn(|i| f[i]).permute(src), B::from_fn(|i| w[i]));
+            *w = std::array::from_fn(|i| v.lane(i));
+        }
+        let kept = self.fast & !set;
+        self.fast = if from.fast & taken == taken {
+            kept | set
+        } else {
+            let mut rest = set;
+            let mut fast = kept;
+            while rest != 0 {
+                let i = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                fast |= ((from.fast >> src[i]) & 1) << i;
+            }
+            fast
+        };
     }
 
     /// Lane `i` takes the lane form `words` ([`PixelSampler::lane_words_at`]), or none.
