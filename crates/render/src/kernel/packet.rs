@@ -225,9 +225,7 @@ impl LaneStreams {
     /// The first `n` lanes hold the camera samples of `jobs`; their streams are not made.
     #[inline(always)]
     fn assign(&mut self, jobs: &JobLanes, n: usize) {
-        self.x = std::array::from_fn(|i| jobs.x[i] as u32);
-        self.y = std::array::from_fn(|i| jobs.y[i] as u32);
-        self.sample = std::array::from_fn(|i| jobs.sample[i] as u32);
+        (self.x, self.y, self.sample) = (jobs.x, jobs.y, jobs.sample);
         self.made &= !(((1u32 << n) - 1) as Lanes);
     }
 
@@ -331,9 +329,9 @@ impl<'a> Jobs<'a> {
                 self.rows_started += 1;
                 self.row_started = true;
             }
-            out.x[n] = self.x;
-            out.y[n] = self.y;
-            out.sample[n] = self.chunk[self.k] as u64;
+            out.x[n] = self.x as u32;
+            out.y[n] = self.y as u32;
+            out.sample[n] = self.chunk[self.k];
             out.slot[n] = self.slot;
             n += 1;
             self.k += 1;
@@ -352,12 +350,13 @@ impl<'a> Jobs<'a> {
     }
 }
 
-/// A batch of jobs: pixel x, y, sample index and slot of each lane.
+/// A batch of jobs: pixel x, y, sample index and slot of each lane (zeros past the
+/// batch's count).
 #[derive(Default)]
 struct JobLanes {
-    x: [usize; LANES],
-    y: [usize; LANES],
-    sample: [u64; LANES],
+    x: [u32; LANES],
+    y: [u32; LANES],
+    sample: [u32; LANES],
     slot: [u32; LANES],
 }
 
@@ -451,6 +450,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         strategy: job.strategy,
         lane_materials: lane_materials.clone().next().is_some(),
         lobe_numbers: lane_materials.clone().any(|m| m.reads_lobe_number()),
+        area_lights: job.scene.shape_light.iter().any(Option::is_some),
     };
     loop {
         k.refill(&mut paths, &mut batch, &mut jobs);
@@ -474,6 +474,8 @@ struct Kernel<'a> {
     /// numbers [`Kernel::vertex_numbers`] draws.
     lane_materials: bool,
     lobe_numbers: bool,
+    /// Whether some shape emits (else a hit never finds emission).
+    area_lights: bool,
 }
 
 /// A vertex's numbers drawn ahead, at the start of its segment, for every live lane
@@ -1003,6 +1005,9 @@ impl<'s> Kernel<'s> {
     /// Emission of the area lights the hits of `hl` lie on.
     #[inline(always)]
     fn area_emission<S: Real, G: Real>(&self, paths: &mut Paths<S, G>, hl: &HitLanes<G>) {
+        if !self.area_lights {
+            return;
+        }
         let scene = self.scene;
         for i in lanes_of(hl.lanes & paths.live) {
             let Some(li) = scene.shape_light[hl.shape[i] as usize] else {
@@ -1083,11 +1088,16 @@ impl<'s> Kernel<'s> {
         let mut delta: Lanes = 0;
         let mut sampled: Lanes = 0;
         let mut todo = chosen;
+        let one_light = !selector.reads_selection_number();
         while todo != 0 {
             let k = light_of[todo.trailing_zeros() as usize];
-            let group = lanes_of(todo)
-                .filter(|&i| light_of[i] == k)
-                .fold(0, |s, i| s | (1 << i));
+            let group = if one_light {
+                todo
+            } else {
+                lanes_of(todo)
+                    .filter(|&i| light_of[i] == k)
+                    .fold(0, |s, i| s | (1 << i))
+            };
             todo &= !group;
             let m = mask::<G>(group);
             match &scene.lights[k] {

@@ -166,9 +166,9 @@ impl PixelSampler {
     #[inline(always)]
     pub(crate) fn lane_words_batch<B: Bits32>(
         &self,
-        xs: &[usize; 8],
-        ys: &[usize; 8],
-        samples: &[u64; 8],
+        xs: &[u32; 8],
+        ys: &[u32; 8],
+        samples: &[u32; 8],
         n: usize,
     ) -> SampleLanes {
         let mut out = SampleLanes::default();
@@ -186,7 +186,7 @@ impl PixelSampler {
             // hashed once a run.
             let mut pixel_key = None;
             for i in 0..n {
-                let pixel = self.pixel(xs[i], ys[i]);
+                let pixel = self.pixel(xs[i] as usize, ys[i] as usize);
                 let key = match pixel_key {
                     Some((p, k)) if p == pixel => k,
                     _ => {
@@ -195,12 +195,13 @@ impl PixelSampler {
                         k
                     }
                 };
-                out.set_words(i, Some(split(mix_seed(key, samples[i]))));
+                out.set_words(i, Some(split(mix_seed(key, samples[i] as u64))));
             }
             return out;
         }
         for i in 0..n {
-            out.set_words(i, self.lane_words_at(xs[i], ys[i], samples[i]));
+            let (x, y, s) = (xs[i] as usize, ys[i] as usize, samples[i] as u64);
+            out.set_words(i, self.lane_words_at(x, y, s));
         }
         out
     }
@@ -330,17 +331,16 @@ mod tests {
                 // register integer lanes, for full and short batches and with a sample
                 // number beyond the spp among them (then lane by lane).
                 for (beyond, n) in [(false, 8), (false, 5), (true, 8)] {
-                    let xs = std::array::from_fn(|i| (round as usize * 7 + i * 13) % w);
-                    let ys = std::array::from_fn(|i| (round as usize + i) % h);
-                    let ss: [u64; 8] = std::array::from_fn(|i| match i {
-                        3 if beyond => (spp + round as usize) as u64,
-                        _ => ((round + i as u32) % spp as u32) as u64,
+                    let xs = std::array::from_fn(|i| ((round as usize * 7 + i * 13) % w) as u32);
+                    let ys = std::array::from_fn(|i| ((round as usize + i) % h) as u32);
+                    let ss: [u32; 8] = std::array::from_fn(|i| match i {
+                        3 if beyond => spp as u32 + round,
+                        _ => (round + i as u32) % spp as u32,
                     });
                     let batch = sampler.lane_words_batch::<U32x8>(&xs, &ys, &ss, n);
                     for i in 0..8 {
-                        let expect = (i < n)
-                            .then(|| sampler.lane_words_at(xs[i], ys[i], ss[i]))
-                            .flatten();
+                        let (x, y, s) = (xs[i] as usize, ys[i] as usize, ss[i] as u64);
+                        let expect = (i < n).then(|| sampler.lane_words_at(x, y, s)).flatten();
                         assert_eq!((batch.fast >> i) & 1 == 1, expect.is_some(), "{kind:?}");
                         if let Some(words) = expect {
                             assert_eq!([batch.words[0][i], batch.words[1][i]], words);

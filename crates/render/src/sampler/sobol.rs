@@ -375,13 +375,17 @@ impl ZSobol {
     #[inline(always)]
     pub(crate) fn lane_words<B: Bits32>(
         &self,
-        xs: &[usize; 8],
-        ys: &[usize; 8],
-        samples: &[u64; 8],
+        xs: &[u32; 8],
+        ys: &[u32; 8],
+        samples: &[u32; 8],
         n: usize,
     ) -> Option<B> {
         let bits = self.index_bits();
-        if bits > 32 || samples[..n].iter().any(|&s| s >> self.log2_spp != 0) {
+        let active = ((1u32 << n) - 1) as u8;
+        let lanes = |a: &[u32; 8]| B::blend_bits(active, B::from_fn(|i| a[i]), B::splat(0));
+        let s = lanes(samples);
+        // A sample number beyond the spp has another key: no lane form.
+        if bits > 32 || (self.log2_spp < 32 && !s.shr(self.log2_spp).all_below(1)) {
             return None;
         }
         if bits == 0 {
@@ -396,8 +400,6 @@ impl ZSobol {
             let v = (v | v.shl(2)) & B::splat(0x3333_3333);
             (v | v.shl(1)) & B::splat(0x5555_5555)
         }
-        let lanes = |a: &[usize; 8]| B::from_fn(|i| if i < n { a[i] as u32 } else { 0 });
-        let s = B::from_fn(|i| if i < n { samples[i] as u32 } else { 0 });
         // log2_spp ≤ bits ≤ 32; at 32 there is no pixel level (and no shift by 32).
         let index = if self.log2_spp >= 32 {
             s
