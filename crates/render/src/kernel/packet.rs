@@ -451,6 +451,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         lane_materials: lane_materials.clone().next().is_some(),
         lobe_numbers: lane_materials.clone().any(|m| m.reads_lobe_number()),
         area_lights: job.scene.shape_light.iter().any(Option::is_some),
+        one_material: job.scene.shape_material.windows(2).all(|w| w[0] == w[1]),
     };
     loop {
         k.refill(&mut paths, &mut batch, &mut jobs);
@@ -476,6 +477,8 @@ struct Kernel<'a> {
     lobe_numbers: bool,
     /// Whether some shape emits (else a hit never finds emission).
     area_lights: bool,
+    /// Whether every shape has the same material (then every hit's lanes share it).
+    one_material: bool,
 }
 
 /// A vertex's numbers drawn ahead, at the start of its segment, for every live lane
@@ -782,7 +785,7 @@ impl<'s> Kernel<'s> {
             m => m.lane_bsdf(),
         };
         let per_lane = match shared_lane {
-            Some(lane) if lanes_of(live).all(|i| material_of(i) == shared) => {
+            Some(lane) if self.one_material || lanes_of(live).all(|i| material_of(i) == shared) => {
                 for i in lanes_of(live) {
                     vertex.bsdfs[i] = VertexBsdf::Lane(lane);
                 }

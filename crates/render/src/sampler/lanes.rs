@@ -49,11 +49,14 @@ impl SeedTable {
     /// where every lane's dimension is tabulated, hashed lane by lane otherwise.
     #[inline(always)]
     fn lanes<B: Bits32>(&self, dims: B, key: u64) -> [B; 3] {
-        if dims.all_below(self.field.len() as u32) {
+        // Three tables of one length: the gathers' bound checks are then one computation,
+        // shared with this test.
+        let n = self.field.len();
+        if dims.all_below(n as u32) {
             return [
-                dims.gather(&self.field),
-                dims.gather(&self.s0),
-                dims.gather(&self.s1),
+                dims.gather(&self.field[..n]),
+                dims.gather(&self.s0[..n]),
+                dims.gather(&self.s1[..n]),
             ];
         }
         let mut s = [DimSeeds::new(key, 0); 8];
