@@ -574,8 +574,9 @@ impl<'s> Kernel<'s> {
     ) {
         let mut free = !paths.live;
         let mut filled: Lanes = 0;
-        // The free lanes take the batch's next rays in order, a batch at a time: the lanes'
-        // scalar state one by one, their rays by one permutation and blend per coordinate.
+        // The free lanes take the batch's next rays in order, a batch at a time: each lane
+        // array (ray coordinates, pixel slot, sampler words, camera sample) by one
+        // permutation and one blend; only ray differentials, where read, lane by lane.
         while free != 0 {
             if batch.next == batch.count && !self.make_batch::<S, G>(batch, jobs) {
                 break;
