@@ -84,6 +84,24 @@ impl U32x8Avx2 {
     }
 }
 
+/// The wrapping 64-bit product of each u64 lane with `c`: the low halves' product plus the
+/// cross products shifted up (the high halves' product leaves the 64 bits).
+#[inline(always)]
+unsafe fn mul_u64(x: __m256i, c: u64) -> __m256i {
+    let lo = _mm256_set1_epi64x(c as i64);
+    let hi = _mm256_set1_epi64x((c >> 32) as i64);
+    let p0 = _mm256_mul_epu32(x, lo);
+    let p1 = _mm256_mul_epu32(_mm256_srli_epi64::<32>(x), lo);
+    let p2 = _mm256_mul_epu32(x, hi);
+    _mm256_add_epi64(p0, _mm256_slli_epi64::<32>(_mm256_add_epi64(p1, p2)))
+}
+
+/// `z ^ (z >> s)` in each u64 lane.
+#[inline(always)]
+unsafe fn xor_shift_u64(z: __m256i, s: i32) -> __m256i {
+    _mm256_xor_si256(z, _mm256_srl_epi64(z, _mm_cvtsi32_si128(s)))
+}
+
 macro_rules! float_op {
     ($tr:ident, $f:ident, $intrinsic:ident) => {
         impl $tr for F32x8Avx2 {
@@ -377,6 +395,25 @@ impl Bits32 for U32x8Avx2 {
             _mm256_permutevar8x32_epi32(self.0, idx)
         })
     }
+    /// SplitMix64's finalizer four lanes to a register, its 64-bit products from three
+    /// `vpmuludq` each (AVX2 has no 64-bit `mullo`).
+    #[inline(always)]
+    fn mix_seeds(a: &[u64; 8], b: &[u64; 8]) -> [u64; 8] {
+        let mut out = [0u64; 8];
+        for h in 0..2 {
+            // SAFETY: 4 u64 = 32 bytes read from and written to each array at 4h.
+            unsafe {
+                let va = _mm256_loadu_si256(a[4 * h..].as_ptr() as *const __m256i);
+                let vb = _mm256_loadu_si256(b[4 * h..].as_ptr() as *const __m256i);
+                let z = _mm256_xor_si256(va, mul_u64(vb, 0x9E37_79B9_7F4A_7C15));
+                let z = mul_u64(xor_shift_u64(z, 30), 0xBF58_476D_1CE4_E5B9);
+                let z = mul_u64(xor_shift_u64(z, 27), 0x94D0_49BB_1331_11EB);
+                let z = xor_shift_u64(z, 31);
+                _mm256_storeu_si256(out[4 * h..].as_mut_ptr() as *mut __m256i, z);
+            }
+        }
+        out
+    }
     #[inline(always)]
     fn blend_bits(set: u8, a: Self, b: Self) -> Self {
         U32x8Avx2(unsafe {
@@ -652,6 +689,39 @@ mod tests {
             assert_eq!(U32x8::blend_bits(set, U32x8(x), U32x8(y)).0, want);
             let p = U32x8Avx2::blend_bits(set, U32x8Avx2::from_array(x), U32x8Avx2::from_array(y));
             assert_eq!(p.to_array(), want, "set {set:08b}");
+        }
+    }
+
+    /// The register lanes' 64-bit hash is `mix_seed`, bit for bit, on edge and random pairs.
+    #[test]
+    fn register_mix_seeds_is_mix_seed() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let mut rng = crate::math::rng::Pcg32::new(7, 3);
+        let mut next = || ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+        let edges = [
+            0,
+            1,
+            u64::MAX,
+            1 << 32,
+            (1 << 32) - 1,
+            1 << 63,
+            0x9E37_79B9_7F4A_7C15,
+        ];
+        for round in 0..64 {
+            let a: [u64; 8] = std::array::from_fn(|i| match round {
+                0 => edges[i % edges.len()],
+                _ => next(),
+            });
+            let b: [u64; 8] = std::array::from_fn(|i| match round {
+                0 => edges[(i + 3) % edges.len()],
+                _ => next(),
+            });
+            let want: [u64; 8] = std::array::from_fn(|i| crate::math::rng::mix_seed(a[i], b[i]));
+            assert_eq!(U32x8Avx2::mix_seeds(&a, &b), want, "{a:?} {b:?}");
+            assert_eq!(U32x8::mix_seeds(&a, &b), want);
         }
     }
 

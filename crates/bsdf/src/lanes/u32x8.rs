@@ -35,6 +35,13 @@ pub trait Bits32:
     fn permute(self, from: &[u8; 8]) -> Self {
         Self::from_fn(|i| self.lane(from[i] as usize))
     }
+    /// [`mix_seed`](crate::math::rng::mix_seed)`(a[i], b[i])` for eight pairs: the
+    /// independent sampler's 64-bit keys of a batch of camera samples (the AVX2 register
+    /// lanes hash four pairs to a register).
+    #[inline(always)]
+    fn mix_seeds(a: &[u64; 8], b: &[u64; 8]) -> [u64; 8] {
+        std::array::from_fn(|i| crate::math::rng::mix_seed(a[i], b[i]))
+    }
     /// Lane `i` of `a` where bit `i` of `set` is 1, else lane `i` of `b`.
     #[inline(always)]
     fn blend_bits(set: u8, a: Self, b: Self) -> Self {

@@ -12,7 +12,6 @@
 use super::sobol::{short_index_point, DimSeeds};
 use super::{independent_point, split, Layout, PixelSampler, SampleStream};
 use facette_bsdf::lanes::{Bits32, Real, U32x8};
-use facette_bsdf::math::rng::mix_seed;
 
 /// The dimensions whose Sobol seeds are tabulated per render (a path of up to 36 vertices
 /// at 7 dimensions each); deeper dimensions hash their seeds lane by lane.
@@ -185,20 +184,13 @@ impl PixelSampler {
             }
         }
         if let Layout::Independent = &self.layout {
-            // A batch holds runs of one pixel's samples: the pixel's half of the key is
-            // hashed once a run.
-            let mut pixel_key = None;
-            for i in 0..n {
-                let pixel = self.pixel(xs[i] as usize, ys[i] as usize);
-                let key = match pixel_key {
-                    Some((p, k)) if p == pixel => k,
-                    _ => {
-                        let k = self.independent_pixel_key(pixel);
-                        pixel_key = Some((pixel, k));
-                        k
-                    }
-                };
-                out.set_words(i, Some(split(mix_seed(key, samples[i] as u64))));
+            // Each lane's key: the pixel's half, then the sample's, by the lanes' 64-bit hash
+            // (`independent_key` for all eight at once; lanes from n on are unused).
+            let pixels = std::array::from_fn(|i| self.pixel(xs[i] as usize, ys[i] as usize));
+            let pixel_keys = B::mix_seeds(&[self.seed ^ super::INDEPENDENT_TAG; 8], &pixels);
+            let keys = B::mix_seeds(&pixel_keys, &samples.map(u64::from));
+            for (i, &key) in keys.iter().enumerate().take(n) {
+                out.set_words(i, Some(split(key)));
             }
             return out;
         }
