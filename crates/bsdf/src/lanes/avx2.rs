@@ -84,6 +84,24 @@ impl U32x8Avx2 {
     }
 }
 
+/// All bits set in lane `i` where bit `i` of `bits` is 1 (lanes 0..8), zero elsewhere.
+#[inline(always)]
+unsafe fn lane_bit_mask(bits: u32) -> __m256i {
+    let lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    _mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bit),
+        lane_bit,
+    )
+}
+
+/// Eight lane indices as 32-bit lanes, for `vpermps`/`vpermd` (which use the low three
+/// bits of each).
+#[inline(always)]
+unsafe fn lane_indices(from: &[u8; 8]) -> __m256i {
+    // SAFETY (caller's AVX2): `from` is 8 readable bytes.
+    _mm256_cvtepu8_epi32(_mm_loadl_epi64(from.as_ptr() as *const __m128i))
+}
+
 /// The wrapping 64-bit product of each u64 lane with `c`: the low halves' product plus the
 /// cross products shifted up (the high halves' product leaves the 64 bits).
 #[inline(always)]
@@ -179,11 +197,7 @@ impl Mask for M32x8Avx2 {
     }
     #[inline(always)]
     fn from_lane_bits(bits: u32) -> Self {
-        unsafe {
-            let lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-            let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bit);
-            M32x8Avx2(_mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane_bit)))
-        }
+        M32x8Avx2(unsafe { _mm256_castsi256_ps(lane_bit_mask(bits)) })
     }
     #[inline(always)]
     fn width() -> usize {
@@ -228,12 +242,7 @@ impl Real for F32x8Avx2 {
     /// One `vpermps`.
     #[inline(always)]
     fn permute(self, from: &[u8; 8]) -> Self {
-        // SAFETY: `from` is 8 readable bytes; every lane index is masked to 0..8 by the
-        // instruction.
-        F32x8Avx2(unsafe {
-            let idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(from.as_ptr() as *const __m128i));
-            _mm256_permutevar8x32_ps(self.0, idx)
-        })
+        F32x8Avx2(unsafe { _mm256_permutevar8x32_ps(self.0, lane_indices(from)) })
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -389,11 +398,7 @@ impl Bits32 for U32x8Avx2 {
     /// One `vpermd`.
     #[inline(always)]
     fn permute(self, from: &[u8; 8]) -> Self {
-        // SAFETY: `from` is 8 readable bytes; the instruction masks each index to 0..8.
-        U32x8Avx2(unsafe {
-            let idx = _mm256_cvtepu8_epi32(_mm_loadl_epi64(from.as_ptr() as *const __m128i));
-            _mm256_permutevar8x32_epi32(self.0, idx)
-        })
+        U32x8Avx2(unsafe { _mm256_permutevar8x32_epi32(self.0, lane_indices(from)) })
     }
     /// SplitMix64's finalizer four lanes to a register, its 64-bit products from three
     /// `vpmuludq` each (AVX2 has no 64-bit `mullo`).
@@ -416,14 +421,7 @@ impl Bits32 for U32x8Avx2 {
     }
     #[inline(always)]
     fn blend_bits(set: u8, a: Self, b: Self) -> Self {
-        U32x8Avx2(unsafe {
-            let lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-            let m = _mm256_cmpeq_epi32(
-                _mm256_and_si256(_mm256_set1_epi32(set as i32), lane_bit),
-                lane_bit,
-            );
-            _mm256_blendv_epi8(b.0, a.0, m)
-        })
+        U32x8Avx2(unsafe { _mm256_blendv_epi8(b.0, a.0, lane_bit_mask(set as u32)) })
     }
     #[inline(always)]
     fn wrapping_add(self, o: Self) -> Self {

@@ -47,7 +47,7 @@ use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIM
 use crate::lights::{Environment, Light};
 use crate::materials::{LaneTexel, MaterialBsdf, SceneMaterial};
 use crate::render::{CameraSampling, PixelSums};
-use crate::sampler::lanes::SampleLanes;
+use crate::sampler::lanes::{move_lanes, SampleLanes};
 use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
 #[cfg(target_arch = "x86_64")]
@@ -82,20 +82,6 @@ fn conv_vec<A: Real, B: Real>(v: LVec3<A>) -> LVec3<B> {
 #[inline(always)]
 fn mask<R: Real>(set: Lanes) -> R::Mask {
     R::Mask::from_lane_bits(set as u32)
-}
-
-/// The lanes `i` of `set` in `dst` take lane `from[i]` of `src`: one permutation and blend.
-#[inline(always)]
-fn move_lanes<B: Bits32>(
-    dst: &mut [u32; LANES],
-    src: &[u32; LANES],
-    from: &[u8; LANES],
-    set: Lanes,
-) {
-    let moved = B::from_fn(|i| src[i]).permute(from);
-    let kept = B::from_fn(|i| dst[i]);
-    let v = B::blend_bits(set, moved, kept);
-    *dst = std::array::from_fn(|i| v.lane(i));
 }
 
 /// The lane set of a mask of 8 lanes.

@@ -78,6 +78,15 @@ impl SeedTable {
     }
 }
 
+/// The lanes `i` of `set` in `dst` take lane `from[i]` of `src`: one permutation and one
+/// blend in the integer lanes `B` (the render kernel's refill moves its lane arrays so).
+#[inline(always)]
+pub(crate) fn move_lanes<B: Bits32>(dst: &mut [u32; 8], src: &[u32; 8], from: &[u8; 8], set: u8) {
+    let moved = B::from_fn(|i| src[i]).permute(from);
+    let v = B::blend_bits(set, moved, B::from_fn(|i| dst[i]));
+    *dst = std::array::from_fn(|i| v.lane(i));
+}
+
 /// Eight camera samples' sampler state: two words per lane (a Sobol sample's reversed
 /// index; an independent sample's key), and the lanes that have them.
 #[derive(Clone, Copy, Debug, Default)]
@@ -111,8 +120,7 @@ impl SampleLanes {
         taken: u8,
     ) {
         for (w, f) in self.words.iter_mut().zip(&from.words) {
-            let v = B::blend_bits(set, B::from_fn(|i| f[i]).permute(src), B::from_fn(|i| w[i]));
-            *w = std::array::from_fn(|i| v.lane(i));
+            move_lanes::<B>(w, f, src, set);
         }
         let kept = self.fast & !set;
         self.fast = if from.fast & taken == taken {
