@@ -73,7 +73,11 @@ const MODELS: &[(&str, &str)] = &[
         r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3}"#,
     ),
     (
-        "il-quadrature-1024",
+        "il-quadrature-256",
+        r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3, evaluation = "quadrature", samples = 256}"#,
+    ),
+    (
+        "il-quadrature-adaptive",
         r#"{type = "il", kd = 0.6, ni = 1.5, distribution = "beckmann", alpha = 0.3, evaluation = "quadrature"}"#,
     ),
     (

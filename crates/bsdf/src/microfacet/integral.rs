@@ -18,7 +18,11 @@
 //! - [`MicrofacetIntegral::estimate_one`]: one microfacet, unbiased — IL18 §4.1's path-tracer
 //!   mode (eq. 28).
 //! - [`MicrofacetIntegral::estimate`]: N microfacets as randomized quasi-Monte Carlo (8
-//!   Cranley–Patterson rotations of a Hammersley set), with its standard error.
+//!   Cranley–Patterson rotations of a Hammersley set), with its standard error;
+//!   [`MicrofacetIntegral::frozen_set`] draws such a set once (each normal with its
+//!   D(m)/pdf(m)) and [`MicrofacetIntegral::estimate_frozen`] evaluates over it, bit for bit
+//!   the same value — what the models with `samples = N` keep, since their set never
+//!   changes (about 8× less work a call: no sampling, no densities).
 //! - [`MicrofacetIntegral::integrate`]: adaptive Gauss–Kronrod quadrature over the
 //!   hemisphere of normals, in (φ_m, θ_m) with dω_m = sin θ_m dθ_m dφ_m, to a relative
 //!   tolerance, with an error estimate ([`crate::math::adaptive_quadrature`]). The
@@ -96,6 +100,39 @@ pub enum TableEntries {
 /// Number of independent rotations of the QMC point set (gives the standard error).
 const QMC_ROTATIONS: usize = 8;
 
+/// The frozen point set of a fixed-N estimate ([`MicrofacetIntegral::frozen_set`]): the
+/// normals of the 8 rotations in order, each with D(m)/pdf(m).
+#[derive(Debug)]
+pub struct FrozenFacets {
+    facets: Vec<(Vec3, f64)>,
+    /// Normals per rotation.
+    per: usize,
+}
+
+impl FrozenFacets {
+    /// Most normals a model keeps frozen (32 bytes each, 2 MiB): larger `samples` are drawn
+    /// at every evaluation instead, with the same values.
+    pub const MAX_NORMALS: usize = 1 << 16;
+
+    /// Normals in the set.
+    pub fn len(&self) -> usize {
+        self.facets.len()
+    }
+
+    /// Whether the set holds no normal (never, for a set from `frozen_set`).
+    pub fn is_empty(&self) -> bool {
+        self.facets.is_empty()
+    }
+}
+
+/// The mean of the rotations' means and its standard error.
+fn mean_and_error(means: &[f64; QMC_ROTATIONS]) -> (f64, f64) {
+    let r = QMC_ROTATIONS as f64;
+    let mean = means.iter().sum::<f64>() / r;
+    let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (r - 1.0);
+    (mean, (var / r).sqrt())
+}
+
 impl MicrofacetIntegral {
     pub fn new(ndf: Ndf, masking: Masking) -> ParamResult<Self> {
         if masking.is_smith() && !ndf.supports_smith() {
@@ -112,20 +149,45 @@ impl MicrofacetIntegral {
     /// hemisphere.
     #[inline]
     pub fn weight(&self, i: Vec3, o: Vec3, m: Vec3, h: impl Fn(Vec3) -> f64) -> f64 {
-        let im = i.dot(m);
-        let om = o.dot(m);
-        if im <= 0.0 || om <= 0.0 || i.z <= 0.0 || o.z <= 0.0 {
+        if i.dot(m) <= 0.0 || o.dot(m) <= 0.0 || i.z <= 0.0 || o.z <= 0.0 {
             return 0.0;
         }
+        self.weight_with_ratio(i, o, m, self.density_ratio(m), h)
+    }
+
+    /// D(m)/pdf(m) of a sampled normal m, 0 where the sampler's density vanishes: the part
+    /// of [`Self::weight`] that depends on m alone.
+    #[inline]
+    fn density_ratio(&self, m: Vec3) -> f64 {
         let pdf = self.ndf.pdf_normal(m);
-        if !(pdf > 0.0) {
+        if pdf > 0.0 {
+            self.ndf.d(m) / pdf
+        } else {
+            0.0
+        }
+    }
+
+    /// [`Self::weight`] with m's D(m)/pdf(m) given (`ratio`, from [`Self::density_ratio`]).
+    #[inline]
+    fn weight_with_ratio(
+        &self,
+        i: Vec3,
+        o: Vec3,
+        m: Vec3,
+        ratio: f64,
+        h: impl Fn(Vec3) -> f64,
+    ) -> f64 {
+        let im = i.dot(m);
+        let om = o.dot(m);
+        if im <= 0.0 || om <= 0.0 || i.z <= 0.0 || o.z <= 0.0 || ratio == 0.0 {
             return 0.0;
         }
         let g = self.masking.g(&self.ndf, i, o, m);
         if g == 0.0 {
             return 0.0;
         }
-        let v = h(m) * self.ndf.d(m) * g * im * om / (i.z * o.z * pdf);
+        // (im om) and (i_z o_z) as products of two: swapping i and o gives the same bits.
+        let v = h(m) * ratio * g * (im * om) / (i.z * o.z);
         guard(v, || {
             format!(
                 "microfacet integral of {} ({}) at i = {i:?}, o = {o:?}, m = {m:?}",
@@ -151,21 +213,59 @@ impl MicrofacetIntegral {
         rng: &mut dyn RandomSource,
         h: impl Fn(Vec3) -> f64,
     ) -> (f64, f64) {
-        let n = n.max(QMC_ROTATIONS);
-        let per = (n / QMC_ROTATIONS) as u32;
+        let per = (n.max(QMC_ROTATIONS) / QMC_ROTATIONS) as u32;
         let mut means = [0.0; QMC_ROTATIONS];
         for mean in means.iter_mut() {
             let shift = rng.next_2d();
             let mut s = 0.0;
             for k in 0..per {
-                s += self.weight(i, o, self.ndf.sample_normal(hammersley(k, per, shift)), &h);
+                let m = self.ndf.sample_normal(hammersley(k, per, shift));
+                s += self.weight_with_ratio(i, o, m, self.density_ratio(m), &h);
             }
             *mean = s / per as f64;
         }
-        let r = QMC_ROTATIONS as f64;
-        let mean = means.iter().sum::<f64>() / r;
-        let var = means.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (r - 1.0);
-        (mean, (var / r).sqrt())
+        mean_and_error(&means)
+    }
+
+    /// The point set that [`Self::estimate`] draws for `n` microfacets from `rng`, drawn
+    /// once: each normal with its D(m)/pdf(m). A model that evaluates with a fixed set
+    /// (`evaluation = "quadrature"` with `samples`) keeps it, and each evaluation is then
+    /// only the masking, the cosines and h — not the normal's sampling and two densities.
+    /// [`Self::estimate_frozen`] over it gives [`Self::estimate`]'s value bit for bit.
+    pub fn frozen_set(&self, n: usize, rng: &mut dyn RandomSource) -> FrozenFacets {
+        let per = (n.max(QMC_ROTATIONS) / QMC_ROTATIONS) as u32;
+        let mut facets = Vec::with_capacity(per as usize * QMC_ROTATIONS);
+        for _ in 0..QMC_ROTATIONS {
+            let shift = rng.next_2d();
+            for k in 0..per {
+                let m = self.ndf.sample_normal(hammersley(k, per, shift));
+                facets.push((m, self.density_ratio(m)));
+            }
+        }
+        FrozenFacets {
+            facets,
+            per: per as usize,
+        }
+    }
+
+    /// [`Self::estimate`] over a set drawn by [`Self::frozen_set`] (the same value and
+    /// standard error, bit for bit).
+    pub fn estimate_frozen(
+        &self,
+        set: &FrozenFacets,
+        i: Vec3,
+        o: Vec3,
+        h: impl Fn(Vec3) -> f64,
+    ) -> (f64, f64) {
+        let mut means = [0.0; QMC_ROTATIONS];
+        for (mean, rotation) in means.iter_mut().zip(set.facets.chunks_exact(set.per)) {
+            let mut s = 0.0;
+            for &(m, ratio) in rotation {
+                s += self.weight_with_ratio(i, o, m, ratio, &h);
+            }
+            *mean = s / set.per as f64;
+        }
+        mean_and_error(&means)
     }
 
     /// The integral by adaptive quadrature to relative tolerance `rel_tol` (with its error
@@ -291,5 +391,39 @@ mod tests {
         let b = mi.estimate(o, i, 512, &mut Pcg32::new(5, 5), |_| 1.0);
         assert_eq!(a.0, b.0);
         assert!((a.1 - b.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_frozen_set_gives_the_streamed_estimate_bit_for_bit() {
+        let models = [
+            MicrofacetIntegral::new(Ndf::Gaussian(Gaussian::new(0.5).unwrap()), Masking::VCavity)
+                .unwrap(),
+            MicrofacetIntegral::new(
+                Ndf::Beckmann(Beckmann::new(0.7, 0.2).unwrap()),
+                Masking::SmithSeparable,
+            )
+            .unwrap(),
+        ];
+        let h = |m: Vec3| 1.0 - 0.3 * (1.0 - m.z).powi(3);
+        let mut rng = Pcg32::new(9, 3);
+        for mi in &models {
+            for n in [8, 100, 256] {
+                let set = mi.frozen_set(n, &mut Pcg32::new(QUADRATURE_SEED, 1));
+                assert_eq!(set.len(), (n / QMC_ROTATIONS) * QMC_ROTATIONS);
+                for _ in 0..50 {
+                    let i = spherical_direction(rng.next_f64() * 1.55, rng.next_f64() * TWO_PI);
+                    let o = spherical_direction(rng.next_f64() * 1.55, rng.next_f64() * TWO_PI);
+                    let streamed = mi.estimate(i, o, n, &mut Pcg32::new(QUADRATURE_SEED, 1), h);
+                    let frozen = mi.estimate_frozen(&set, i, o, h);
+                    assert_eq!(streamed.0.to_bits(), frozen.0.to_bits(), "{i:?} {o:?}");
+                    assert_eq!(streamed.1.to_bits(), frozen.1.to_bits());
+                    // Reciprocal bit for bit.
+                    assert_eq!(
+                        mi.estimate_frozen(&set, o, i, h).0.to_bits(),
+                        frozen.0.to_bits()
+                    );
+                }
+            }
+        }
     }
 }

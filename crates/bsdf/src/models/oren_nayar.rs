@@ -28,9 +28,17 @@ use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
-use crate::microfacet::integral::{check_tolerance, MicrofacetIntegral, QUADRATURE_SEED};
+use crate::microfacet::integral::{
+    check_tolerance, FrozenFacets, MicrofacetIntegral, QUADRATURE_SEED,
+};
 use crate::microfacet::{Gaussian, Masking, Ndf};
 use crate::two_sided::OpaqueBsdf;
+use std::sync::Arc;
+
+/// The stream of the model's fixed quadrature set (the IL body uses stream 1).
+fn quadrature_stream() -> Pcg32 {
+    Pcg32::new(QUADRATURE_SEED, 0)
+}
 
 /// How a model estimates its microfacet integral.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +63,9 @@ pub struct OrenNayarExact {
     sigma: f64,
     integral: MicrofacetIntegral,
     evaluation: IntegralEvaluation,
+    /// The fixed point set of `evaluation = "quadrature"` with `samples`, drawn once (up to
+    /// [`FrozenFacets::MAX_NORMALS`]).
+    frozen: Option<Arc<FrozenFacets>>,
 }
 
 impl OrenNayarExact {
@@ -71,14 +82,22 @@ impl OrenNayarExact {
         if let IntegralEvaluation::Adaptive { tolerance } = evaluation {
             check_tolerance(tolerance)?;
         }
+        let integral =
+            MicrofacetIntegral::new(Ndf::Gaussian(Gaussian::new(sigma)?), Masking::VCavity)?;
+        let frozen = match evaluation {
+            IntegralEvaluation::Quadrature { samples } if samples <= FrozenFacets::MAX_NORMALS => {
+                Some(Arc::new(
+                    integral.frozen_set(samples, &mut quadrature_stream()),
+                ))
+            }
+            _ => None,
+        };
         Ok(OrenNayarExact {
             reflectance,
             sigma,
-            integral: MicrofacetIntegral::new(
-                Ndf::Gaussian(Gaussian::new(sigma)?),
-                Masking::VCavity,
-            )?,
+            integral,
             evaluation,
+            frozen,
         })
     }
 
@@ -90,10 +109,12 @@ impl OrenNayarExact {
                 self.integral.estimate_one(i, o, rng.next_2d(), |_| 1.0),
                 0.0,
             ),
-            IntegralEvaluation::Quadrature { samples } => {
-                self.integral
-                    .estimate(i, o, samples, &mut Pcg32::new(QUADRATURE_SEED, 0), |_| 1.0)
-            }
+            IntegralEvaluation::Quadrature { samples } => match &self.frozen {
+                Some(set) => self.integral.estimate_frozen(set, i, o, |_| 1.0),
+                None => self
+                    .integral
+                    .estimate(i, o, samples, &mut quadrature_stream(), |_| 1.0),
+            },
             IntegralEvaluation::Adaptive { tolerance } => {
                 let q = self.integral.integrate(i, o, tolerance, |_| 1.0);
                 (q.value, q.error)

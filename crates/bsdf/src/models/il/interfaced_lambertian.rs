@@ -51,7 +51,9 @@ use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI};
-use crate::microfacet::integral::{check_tolerance, MicrofacetIntegral, QUADRATURE_SEED};
+use crate::microfacet::integral::{
+    check_tolerance, FrozenFacets, MicrofacetIntegral, QUADRATURE_SEED,
+};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
 use crate::two_sided::OpaqueBsdf;
@@ -140,6 +142,9 @@ pub struct InterfacedLambertian {
     /// Deterministic multiple scattering for `eval` (`multiple_evaluation = "quadrature"`);
     /// `None`: the V-cavity walk. Sampling always uses the walk.
     ms_quadrature: Option<Arc<VCavityQuadrature>>,
+    /// The fixed point set of `evaluation = "quadrature"` with `samples`, drawn once (up to
+    /// [`FrozenFacets::MAX_NORMALS`]).
+    frozen_body: Option<Arc<FrozenFacets>>,
 }
 
 /// K_d/(n_i² (1 − K_d r_i)) per channel: the body's factor in IL18 eq. 13 (r_i the internal
@@ -201,6 +206,16 @@ impl InterfacedLambertian {
             t.check_matches(ni, l)?;
         }
         let specular_probability = specular_probability(kd, ni, re, ri);
+        let frozen_body = match (&evaluation, &integral) {
+            (BodyEvaluation::Quadrature { samples }, Some(integral))
+                if *samples <= FrozenFacets::MAX_NORMALS =>
+            {
+                Some(Arc::new(
+                    integral.frozen_set(*samples, &mut Pcg32::new(QUADRATURE_SEED, 1)),
+                ))
+            }
+            _ => None,
+        };
         Ok(InterfacedLambertian {
             kd,
             ni,
@@ -213,6 +228,7 @@ impl InterfacedLambertian {
             scattering,
             specular_probability,
             ms_quadrature: None,
+            frozen_body,
         })
     }
 
@@ -329,9 +345,10 @@ impl InterfacedLambertian {
                 });
                 (m[0], se[0])
             }
-            BodyEvaluation::Quadrature { samples } => {
-                integral.estimate(i, o, *samples, &mut Pcg32::new(QUADRATURE_SEED, 1), h)
-            }
+            BodyEvaluation::Quadrature { samples } => match &self.frozen_body {
+                Some(set) => integral.estimate_frozen(set, i, o, h),
+                None => integral.estimate(i, o, *samples, &mut Pcg32::new(QUADRATURE_SEED, 1), h),
+            },
             BodyEvaluation::Adaptive { tolerance } => {
                 let q = integral.integrate(i, o, *tolerance, h);
                 (q.value, q.error)
