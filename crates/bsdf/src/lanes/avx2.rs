@@ -423,6 +423,19 @@ impl Bits32 for U32x8Avx2 {
     fn blend_bits(set: u8, a: Self, b: Self) -> Self {
         U32x8Avx2(unsafe { _mm256_blendv_epi8(b.0, a.0, lane_bit_mask(set as u32)) })
     }
+    /// One unsigned compare (`vpmaxud`, `vpcmpeqd`) and one `vmovmskps`.
+    #[inline(always)]
+    fn above_bits(self, v: u32) -> u8 {
+        if v == u32::MAX {
+            return 0;
+        }
+        // SAFETY: AVX2 (module rule). self > v ⟺ max(self, v + 1) = self.
+        unsafe {
+            let next = _mm256_set1_epi32(v.wrapping_add(1) as i32);
+            let above = _mm256_cmpeq_epi32(_mm256_max_epu32(self.0, next), self.0);
+            _mm256_movemask_ps(_mm256_castsi256_ps(above)) as u8
+        }
+    }
     #[inline(always)]
     fn wrapping_add(self, o: Self) -> Self {
         U32x8Avx2(unsafe { _mm256_add_epi32(self.0, o.0) })
@@ -720,6 +733,35 @@ mod tests {
             let want: [u64; 8] = std::array::from_fn(|i| crate::math::rng::mix_seed(a[i], b[i]));
             assert_eq!(U32x8Avx2::mix_seeds(&a, &b), want, "{a:?} {b:?}");
             assert_eq!(U32x8::mix_seeds(&a, &b), want);
+        }
+    }
+
+    /// The lanes above a value, as bits, agree with the array lanes and with the definition,
+    /// across the unsigned range (the sign bit included) and at both ends of `v`.
+    #[test]
+    fn register_lanes_above_a_value_are_the_definitions() {
+        if !available() {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
+            return;
+        }
+        let lanes = [0, 1, 7, 8, 1 << 31, u32::MAX, u32::MAX - 1, 5];
+        for v in [
+            0,
+            1,
+            5,
+            7,
+            8,
+            (1 << 31) - 1,
+            1 << 31,
+            u32::MAX - 1,
+            u32::MAX,
+        ] {
+            let want = (0..8).fold(0u8, |s, i| s | ((lanes[i] > v) as u8) << i);
+            assert_eq!(U32x8Avx2::from_array(lanes).above_bits(v), want, "{v}");
+            assert_eq!(U32x8(lanes).above_bits(v), want, "{v}");
+        }
+        for (i, &l) in lanes.iter().enumerate() {
+            assert_eq!(l.above_bits(4) != 0, l > 4, "{i}");
         }
     }
 

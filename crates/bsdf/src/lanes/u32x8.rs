@@ -54,6 +54,12 @@ pub trait Bits32:
         })
     }
 
+    /// The lanes above `v` as a bit set (bit `i` for lane `i`).
+    #[inline(always)]
+    fn above_bits(self, v: u32) -> u8 {
+        (0..Self::LANES).fold(0, |s, i| s | ((self.lane(i) > v) as u8) << i)
+    }
+
     /// The bits in reverse order: five swaps of ever smaller fields (the branch-free
     /// reversal, which vectorizes; `u32::reverse_bits` is one instruction only on ARM).
     #[inline(always)]

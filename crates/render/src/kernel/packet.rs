@@ -52,7 +52,7 @@ use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
 #[cfg(target_arch = "x86_64")]
 use facette_bsdf::lanes::F32x8Avx2;
-use facette_bsdf::lanes::{channels, Bits32, F32x8, LFrame, LVec3, Mask, Real, U32x8};
+use facette_bsdf::lanes::{channels, Bits32, F32x8, LFrame, LVec3, Mask, Real};
 use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
 use facette_bsdf::models::{LaneBsdf, LaneColors, LaneRandom, OwnColors};
@@ -119,7 +119,7 @@ fn rgb_set<S: Real>(c: &mut Rgb<S>, i: usize, v: Spectrum) {
 
 /// The eight paths of a thread: shading values in lanes of `S`, rays and points in lanes
 /// of `G`.
-struct Paths<S: Real, G: Real> {
+struct Paths<S: ShadingLanes, G: Real> {
     /// Lanes holding a path.
     live: Lanes,
     /// Each lane's pixel, as an index into the tile's sums.
@@ -137,7 +137,7 @@ struct Paths<S: Real, G: Real> {
     prev_p: LVec3<G>,
     eta_scale: S,
     /// Segments so far (the camera ray is segment 1).
-    segment: U32x8,
+    segment: S::Bits,
 }
 
 /// The ray queries' results of the current segment and the materials at its hits, kept
@@ -426,7 +426,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         prev_pdf: S::zero(),
         prev_p: LVec3::zero(),
         eta_scale: S::one(),
-        segment: U32x8::splat(1),
+        segment: S::Bits::splat(1),
     };
     let lane_materials = job.scene.materials.iter().filter_map(|m| m.lane_bsdf());
     let k = Kernel {
@@ -606,13 +606,7 @@ impl<'s> Kernel<'s> {
         paths.prev_pdf = merge(filled, S::zero(), paths.prev_pdf);
         paths.eta_scale = merge(filled, S::one(), paths.eta_scale);
         paths.prev_p = LVec3::select(mask::<G>(filled), paths.o, paths.prev_p);
-        paths.segment = U32x8::from_fn(|i| {
-            if filled & (1 << i) != 0 {
-                1
-            } else {
-                paths.segment.lane(i)
-            }
-        });
+        paths.segment = S::Bits::blend_bits(filled, S::Bits::splat(1), paths.segment);
     }
 
     /// The camera rays of the next (up to) eight jobs; `false` when no job is left.
@@ -643,7 +637,7 @@ impl<'s> Kernel<'s> {
         let (u0, u1) = self.sampler.get_lanes::<S, S::Bits>(
             &batch.samples,
             batch.streams.all(),
-            U32x8::splat(0),
+            S::Bits::splat(0),
             active,
             true,
         );
@@ -654,7 +648,7 @@ impl<'s> Kernel<'s> {
             let (l0, l1) = self.sampler.get_lanes::<S, S::Bits>(
                 &batch.samples,
                 batch.streams.all(),
-                U32x8::splat(2),
+                S::Bits::splat(2),
                 active,
                 true,
             );
@@ -691,7 +685,12 @@ impl<'s> Kernel<'s> {
 
     /// Adds `beta · le · w` to the lanes of `set`.
     #[inline(always)]
-    fn add_radiance<S: Real, G: Real>(paths: &mut Paths<S, G>, set: Lanes, le: &Rgb<S>, w: S) {
+    fn add_radiance<S: ShadingLanes, G: Real>(
+        paths: &mut Paths<S, G>,
+        set: Lanes,
+        le: &Rgb<S>,
+        w: S,
+    ) {
         for ((l, beta), le) in paths.l.iter_mut().zip(&paths.beta).zip(le) {
             *l = merge(set, *l + *beta * *le * w, *l);
         }
@@ -699,7 +698,11 @@ impl<'s> Kernel<'s> {
 
     /// Ends the paths of `set`: their radiance goes to their pixels.
     #[inline(always)]
-    fn finish<S: Real, G: Real>(paths: &mut Paths<S, G>, set: Lanes, sums: &mut [PixelSums]) {
+    fn finish<S: ShadingLanes, G: Real>(
+        paths: &mut Paths<S, G>,
+        set: Lanes,
+        sums: &mut [PixelSums],
+    ) {
         // Which lanes' radiance is finite and not negative, for all lanes at once.
         let ok = paths.l.iter().fold(set, |ok, c| {
             ok & set_of(c.is_finite()) & set_of(c.ge(S::zero()))
@@ -729,9 +732,9 @@ impl<'s> Kernel<'s> {
         let scene = self.scene;
         let block = paths
             .segment
-            .wrapping_add(U32x8::splat(u32::MAX))
-            .wrapping_mul(U32x8::splat(VERTEX_DIMENSIONS))
-            .wrapping_add(U32x8::splat(CAMERA_DIMENSIONS));
+            .wrapping_add(S::Bits::splat(u32::MAX))
+            .wrapping_mul(S::Bits::splat(VERTEX_DIMENSIONS))
+            .wrapping_add(S::Bits::splat(CAMERA_DIMENSIONS));
         let numbers = self.vertex_numbers(paths, block);
         let rays = LaneRays::new(paths.o, paths.d, G::splat(f64::INFINITY), paths.live);
         let (hit_set, hit_t) = scene.geometry.intersect_lanes(&rays, &mut segment.hits);
@@ -748,7 +751,10 @@ impl<'s> Kernel<'s> {
             .hit_lanes(&rays, &segment.hits, (hit_set, hit_t), &mut segment.record);
         let hl = &segment.record;
         self.area_emission(paths, hl);
-        let deep = paths.segment.ge_splat(scene.integrator.max_depth) & paths.live;
+        let deep = paths
+            .segment
+            .above_bits(scene.integrator.max_depth.saturating_sub(1))
+            & paths.live;
         if deep != 0 {
             Self::finish(paths, deep, sums);
         }
@@ -865,7 +871,7 @@ impl<'s> Kernel<'s> {
     fn vertex_numbers<S: ShadingLanes, G: Real>(
         &self,
         paths: &mut Paths<S, G>,
-        block: U32x8,
+        block: S::Bits,
     ) -> VertexNumbers<S> {
         // No closures here: a closure is compiled with its defining function's instruction
         // set, and this one is generic, without the AVX2 build's (see `lanes::channels`).
@@ -902,7 +908,7 @@ impl<'s> Kernel<'s> {
     fn draw<S: ShadingLanes, G: Real>(
         &self,
         paths: &mut Paths<S, G>,
-        block: U32x8,
+        block: S::Bits,
         offset: u32,
         set: Lanes,
         pair: bool,
@@ -910,7 +916,7 @@ impl<'s> Kernel<'s> {
         self.sampler.get_lanes::<S, S::Bits>(
             &paths.samples,
             paths.streams.all(),
-            block.wrapping_add(U32x8::splat(offset)),
+            block.wrapping_add(S::Bits::splat(offset)),
             set,
             pair,
         )
@@ -919,7 +925,7 @@ impl<'s> Kernel<'s> {
     /// Lane `i`'s texture coordinates and footprint where its material `m` reads them (what
     /// the scalar integrator computes at the same hit), zeros otherwise.
     #[inline(always)]
-    fn surface_details<S: Real, G: Real>(
+    fn surface_details<S: ShadingLanes, G: Real>(
         &self,
         paths: &Paths<S, G>,
         hl: &HitLanes<G>,
@@ -994,7 +1000,7 @@ impl<'s> Kernel<'s> {
 
     /// Emission of the area lights the hits of `hl` lie on.
     #[inline(always)]
-    fn area_emission<S: Real, G: Real>(&self, paths: &mut Paths<S, G>, hl: &HitLanes<G>) {
+    fn area_emission<S: ShadingLanes, G: Real>(&self, paths: &mut Paths<S, G>, hl: &HitLanes<G>) {
         if !self.area_lights {
             return;
         }
@@ -1278,7 +1284,7 @@ impl<'s> Kernel<'s> {
         frame: &LFrame<G>,
         wo: LVec3<S>,
         vertex: &VertexMaterials,
-        block: U32x8,
+        block: S::Bits,
         numbers: &VertexNumbers<S>,
         sums: &mut [PixelSums],
     ) {
@@ -1364,9 +1370,10 @@ impl<'s> Kernel<'s> {
         paths.prev_p = LVec3::select(mask::<G>(go), hl.p, paths.prev_p);
         let refracted = go & transmitted;
         paths.eta_scale = merge(refracted, paths.eta_scale * (eta * eta), paths.eta_scale);
-        paths.segment = U32x8::from_fn(|i| paths.segment.lane(i) + ((go >> i) & 1) as u32);
+        let one = S::Bits::splat(1);
+        paths.segment = S::Bits::blend_bits(go, paths.segment.wrapping_add(one), paths.segment);
         // Russian roulette after rr_depth segments.
-        let rr = go & paths.segment.gt_splat(self.scene.integrator.rr_depth);
+        let rr = go & paths.segment.above_bits(self.scene.integrator.rr_depth);
         let mut killed: Lanes = 0;
         if rr != 0 {
             let q = paths.beta[0].max(paths.beta[1]).max(paths.beta[2]) * paths.eta_scale;
@@ -1423,23 +1430,6 @@ fn power_heuristic_lanes<S: Real>(a: S, b: S) -> S {
     let (a2, b2) = (a * a, b * b);
     let sum = a2 + b2;
     S::select(sum.eq(S::zero()), S::zero(), a2 / sum)
-}
-
-/// Comparisons of u32 lanes with a constant: the lanes where it holds.
-trait LaneCompare {
-    fn ge_splat(self, v: u32) -> Lanes;
-    fn gt_splat(self, v: u32) -> Lanes;
-}
-
-impl LaneCompare for U32x8 {
-    #[inline(always)]
-    fn ge_splat(self, v: u32) -> Lanes {
-        (0..LANES).fold(0, |s, i| s | ((self.lane(i) >= v) as Lanes) << i)
-    }
-    #[inline(always)]
-    fn gt_splat(self, v: u32) -> Lanes {
-        (0..LANES).fold(0, |s, i| s | ((self.lane(i) > v) as Lanes) << i)
-    }
 }
 
 #[cfg(test)]

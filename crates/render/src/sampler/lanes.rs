@@ -11,7 +11,7 @@
 
 use super::sobol::{short_index_point, DimSeeds};
 use super::{independent_point, split, Layout, PixelSampler, SampleStream};
-use facette_bsdf::lanes::{Bits32, Real, U32x8};
+use facette_bsdf::lanes::{Bits32, Real};
 
 /// The dimensions whose Sobol seeds are tabulated per render (a path of up to 36 vertices
 /// at 7 dimensions each); deeper dimensions hash their seeds lane by lane.
@@ -49,9 +49,10 @@ impl SeedTable {
     #[inline(always)]
     fn lanes<B: Bits32>(&self, dims: B, key: u64) -> [B; 3] {
         // Three tables of one length: the gathers' bound checks are then one computation,
-        // shared with this test.
+        // shared with this test (written as `gather` writes its own, so that LLVM sees the
+        // same computation).
         let n = self.field.len();
-        if dims.all_below(n as u32) {
+        if dims.all_below(n.min(1 << 31) as u32) {
             return [
                 dims.gather(&self.field[..n]),
                 dims.gather(&self.s0[..n]),
@@ -229,21 +230,17 @@ impl PixelSampler {
         &self,
         lanes: &SampleLanes,
         streams: &mut [SampleStream],
-        dims: U32x8,
+        dims: B,
         active: u8,
         pair: bool,
     ) -> (S, S) {
         let words = |k: usize| B::from_fn(|i| lanes.words[k][i]);
         let (x, y) = match &self.layout {
             Layout::Sobol(z) if !self.dim_seeds.is_empty() => {
-                let seeds = self
-                    .dim_seeds
-                    .lanes(B::from_fn(|i| dims.lane(i)), z.common_key());
+                let seeds = self.dim_seeds.lanes(dims, z.common_key());
                 short_index_point(words(0), z.index_bits(), seeds, pair)
             }
-            Layout::Independent => {
-                independent_point([words(0), words(1)], B::from_fn(|i| dims.lane(i)))
-            }
+            Layout::Independent => independent_point([words(0), words(1)], dims),
             _ => (B::splat(1 << 31), B::splat(1 << 31)),
         };
         let (mut x, mut y): (S, S) = (x.unit(), y.unit());
@@ -285,7 +282,7 @@ impl PixelSampler {
 mod tests {
     use super::*;
     use crate::sampler::SamplerKind;
-    use facette_bsdf::lanes::{F32x8, F64x8};
+    use facette_bsdf::lanes::{F32x8, F64x8, U32x8};
 
     /// Every lane's value is its stream's, to the bit in f64 lanes and to f32 rounding (and
     /// never 1) in f32 lanes, for lanes at different dimensions, inside and beyond the tabulated
@@ -370,7 +367,7 @@ mod tests {
                         let (xr, yr) = sampler.get_lanes::<F32x8Avx2, U32x8Avx2>(
                             &lanes,
                             &mut streams,
-                            dims,
+                            U32x8Avx2::from_array(dims.0),
                             active,
                             pair,
                         );
