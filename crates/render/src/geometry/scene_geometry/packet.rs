@@ -396,16 +396,23 @@ impl SceneGeometry {
         }
         // Every lane's shape (the lanes without a hit read a stale or default slot, which
         // is a valid one: the scene has primitives since a lane hit one), then the lanes
-        // of each shape by one comparison per lane.
-        let shapes: [u32; PACKET] =
-            std::array::from_fn(|i| self.prims[hits[i].slot as usize].shape);
+        // of each shape by one comparison per lane — or, in a scene of one shape, every
+        // hit lane at once.
+        let one_shape = self.shapes.len() == 1;
+        let shapes: [u32; PACKET] = if one_shape {
+            [0; PACKET]
+        } else {
+            std::array::from_fn(|i| self.prims[hits[i].slot as usize].shape)
+        };
         let mut todo = found;
         while todo != 0 {
             let first = todo.trailing_zeros() as usize;
             let shape = shapes[first];
-            let group = (0..PACKET)
-                .fold(0, |m: Lanes, i| m | (((shapes[i] == shape) as Lanes) << i))
-                & todo;
+            let group = if one_shape {
+                todo
+            } else {
+                (0..PACKET).fold(0, |m: Lanes, i| m | (((shapes[i] == shape) as Lanes) << i)) & todo
+            };
             todo &= !group;
             match &self.shapes[shape as usize] {
                 Shape::Sphere(sphere) if group.count_ones() > 1 => {
