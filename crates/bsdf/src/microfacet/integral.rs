@@ -219,8 +219,8 @@ impl MicrofacetIntegral {
             let shift = rng.next_2d();
             let mut s = 0.0;
             for k in 0..per {
-                let m = self.ndf.sample_normal(hammersley(k, per, shift));
-                s += self.weight_with_ratio(i, o, m, self.density_ratio(m), &h);
+                // `weight` skips the densities of facets facing away from i or o.
+                s += self.weight(i, o, self.ndf.sample_normal(hammersley(k, per, shift)), &h);
             }
             *mean = s / per as f64;
         }
