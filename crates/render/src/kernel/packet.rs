@@ -751,6 +751,7 @@ impl<'s> Kernel<'s> {
             .hit_lanes(&rays, &segment.hits, (hit_set, hit_t), &mut segment.record);
         let hl = &segment.record;
         self.area_emission(paths, hl);
+        // segment ≥ max_depth (the count starts at 1, so max_depth 0 ends every path too).
         let deep = paths
             .segment
             .above_bits(scene.integrator.max_depth.saturating_sub(1))
