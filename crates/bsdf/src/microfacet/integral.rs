@@ -31,11 +31,12 @@
 use crate::error::{ParamError, ParamResult};
 use crate::finite::guard;
 use crate::math::adaptive_quadrature::{integrate_2d, InnerRange, QuadResult, Tolerance};
-use crate::math::rng::RandomSource;
+use crate::math::rng::{Pcg32, RandomSource};
 use crate::math::warp::hammersley;
 use crate::math::{spherical_direction, PI, TWO_PI};
 use crate::math::{Vec2, Vec3};
 use crate::microfacet::{Distribution, Masking, Ndf};
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct MicrofacetIntegral {
@@ -268,6 +269,31 @@ impl MicrofacetIntegral {
         mean_and_error(&means)
     }
 
+    /// The fixed set of a model's `samples = N` (stream `stream` of [`QUADRATURE_SEED`]),
+    /// frozen — or `None` above [`FrozenFacets::MAX_NORMALS`], where
+    /// [`Self::estimate_fixed`] draws it at each call instead.
+    pub fn freeze(&self, samples: usize, stream: u64) -> Option<Arc<FrozenFacets>> {
+        (samples <= FrozenFacets::MAX_NORMALS)
+            .then(|| Arc::new(self.frozen_set(samples, &mut Pcg32::new(QUADRATURE_SEED, stream))))
+    }
+
+    /// A model's fixed-N estimate: over its frozen set where [`Self::freeze`] made one,
+    /// otherwise over the same set drawn now (the same value either way).
+    pub fn estimate_fixed(
+        &self,
+        frozen: Option<&FrozenFacets>,
+        samples: usize,
+        stream: u64,
+        i: Vec3,
+        o: Vec3,
+        h: impl Fn(Vec3) -> f64,
+    ) -> (f64, f64) {
+        match frozen {
+            Some(set) => self.estimate_frozen(set, i, o, h),
+            None => self.estimate(i, o, samples, &mut Pcg32::new(QUADRATURE_SEED, stream), h),
+        }
+    }
+
     /// The integral by adaptive quadrature to relative tolerance `rel_tol` (with its error
     /// estimate and cost), i and o in the upper hemisphere.
     ///
@@ -368,7 +394,6 @@ impl MicrofacetIntegral {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::rng::Pcg32;
     use crate::math::spherical_direction;
     use crate::microfacet::{Beckmann, Gaussian};
 

@@ -24,21 +24,17 @@ use crate::checks::{check_min_count, check_range, check_reflectance, Bounds};
 use crate::error::ParamResult;
 use crate::finite::guard;
 use crate::math::cosine_lobe::sample_cosine_same_side;
-use crate::math::rng::{Pcg32, RandomSource};
+use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI, PI};
-use crate::microfacet::integral::{
-    check_tolerance, FrozenFacets, MicrofacetIntegral, QUADRATURE_SEED,
-};
+use crate::microfacet::integral::{check_tolerance, FrozenFacets, MicrofacetIntegral};
 use crate::microfacet::{Gaussian, Masking, Ndf};
 use crate::two_sided::OpaqueBsdf;
 use std::sync::Arc;
 
 /// The stream of the model's fixed quadrature set (the IL body uses stream 1).
-fn quadrature_stream() -> Pcg32 {
-    Pcg32::new(QUADRATURE_SEED, 0)
-}
+const QUADRATURE_STREAM: u64 = 0;
 
 /// How a model estimates its microfacet integral.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,10 +81,8 @@ impl OrenNayarExact {
         let integral =
             MicrofacetIntegral::new(Ndf::Gaussian(Gaussian::new(sigma)?), Masking::VCavity)?;
         let frozen = match evaluation {
-            IntegralEvaluation::Quadrature { samples } if samples <= FrozenFacets::MAX_NORMALS => {
-                Some(Arc::new(
-                    integral.frozen_set(samples, &mut quadrature_stream()),
-                ))
+            IntegralEvaluation::Quadrature { samples } => {
+                integral.freeze(samples, QUADRATURE_STREAM)
             }
             _ => None,
         };
@@ -109,12 +103,14 @@ impl OrenNayarExact {
                 self.integral.estimate_one(i, o, rng.next_2d(), |_| 1.0),
                 0.0,
             ),
-            IntegralEvaluation::Quadrature { samples } => match &self.frozen {
-                Some(set) => self.integral.estimate_frozen(set, i, o, |_| 1.0),
-                None => self
-                    .integral
-                    .estimate(i, o, samples, &mut quadrature_stream(), |_| 1.0),
-            },
+            IntegralEvaluation::Quadrature { samples } => self.integral.estimate_fixed(
+                self.frozen.as_deref(),
+                samples,
+                QUADRATURE_STREAM,
+                i,
+                o,
+                |_| 1.0,
+            ),
             IntegralEvaluation::Adaptive { tolerance } => {
                 let q = self.integral.integrate(i, o, tolerance, |_| 1.0);
                 (q.value, q.error)

@@ -47,13 +47,11 @@ use crate::fresnel::{
     external_diffuse_reflectance, fresnel_dielectric, internal_diffuse_reflectance,
 };
 use crate::math::cosine_lobe::sample_cosine_same_side;
-use crate::math::rng::{Pcg32, RandomSource};
+use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
 use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{fmt_num, Vec3, INV_PI};
-use crate::microfacet::integral::{
-    check_tolerance, FrozenFacets, MicrofacetIntegral, QUADRATURE_SEED,
-};
+use crate::microfacet::integral::{check_tolerance, FrozenFacets, MicrofacetIntegral};
 use crate::microfacet::specular_lobe::SpecularLobe;
 use crate::microfacet::{Distribution, Masking};
 use crate::two_sided::OpaqueBsdf;
@@ -147,6 +145,9 @@ pub struct InterfacedLambertian {
     frozen_body: Option<Arc<FrozenFacets>>,
 }
 
+/// The stream of the body's fixed quadrature set (exact Oren–Nayar uses stream 0).
+const QUADRATURE_STREAM: u64 = 1;
+
 /// K_d/(n_i² (1 − K_d r_i)) per channel: the body's factor in IL18 eq. 13 (r_i the internal
 /// diffuse reflectance of the interface).
 pub(crate) fn body_factor(kd: Spectrum, ni: f64, ri: f64) -> Spectrum {
@@ -207,12 +208,8 @@ impl InterfacedLambertian {
         }
         let specular_probability = specular_probability(kd, ni, re, ri);
         let frozen_body = match (&evaluation, &integral) {
-            (BodyEvaluation::Quadrature { samples }, Some(integral))
-                if *samples <= FrozenFacets::MAX_NORMALS =>
-            {
-                Some(Arc::new(
-                    integral.frozen_set(*samples, &mut Pcg32::new(QUADRATURE_SEED, 1)),
-                ))
+            (BodyEvaluation::Quadrature { samples }, Some(integral)) => {
+                integral.freeze(*samples, QUADRATURE_STREAM)
             }
             _ => None,
         };
@@ -345,10 +342,14 @@ impl InterfacedLambertian {
                 });
                 (m[0], se[0])
             }
-            BodyEvaluation::Quadrature { samples } => match &self.frozen_body {
-                Some(set) => integral.estimate_frozen(set, i, o, h),
-                None => integral.estimate(i, o, *samples, &mut Pcg32::new(QUADRATURE_SEED, 1), h),
-            },
+            BodyEvaluation::Quadrature { samples } => integral.estimate_fixed(
+                self.frozen_body.as_deref(),
+                *samples,
+                QUADRATURE_STREAM,
+                i,
+                o,
+                h,
+            ),
             BodyEvaluation::Adaptive { tolerance } => {
                 let q = integral.integrate(i, o, *tolerance, h);
                 (q.value, q.error)
