@@ -48,8 +48,8 @@ fn surface(kind: usize) -> Arc<GlintSurface> {
                     println!("  {l}");
                 }
                 println!(
-                    "  one lobe: {} bytes (std::mem::size_of)",
-                    std::mem::size_of_val(&s.lobes()[0])
+                    "  one lobe: {} bytes (std::mem::size_of of a 16-lobe block / 16)",
+                    std::mem::size_of::<facette_bsdf::models::glint::lobe_blocks::LobeBlock>() / 16
                 );
                 Arc::new(s)
             })

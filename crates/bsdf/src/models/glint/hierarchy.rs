@@ -9,7 +9,8 @@
 //! the 99 % box), exact where the paper's is approximate, so skipping a node never drops a
 //! contribution. The position extent of a node is implicit in its index.
 //!
-//! Leaves hold [`LEAF`]×[`LEAF`] texels (their lobes are tested one by one): 16 bytes per
+//! Leaves hold [`LEAF`]×[`LEAF`] texels (their lobes are evaluated together, in lanes:
+//! [`super::lobe_blocks`]): 16 bytes per
 //! node, ≈ 1/12 node per texel — 1.33 bytes per texel, 5.3 MiB for a 2048² map.
 
 use super::lobe::{SlopeLobe, CUTOFF_R2};
@@ -129,8 +130,28 @@ impl SlopeHierarchy {
     pub fn for_each_candidate(
         &self,
         s: [f32; 2],
-        mut node_ok: impl FnMut(usize, usize, usize, usize) -> bool,
+        node_ok: impl FnMut(usize, usize, usize, usize) -> bool,
         mut lobe: impl FnMut(usize, usize),
+    ) {
+        self.for_each_leaf(s, node_ok, |bx, by| {
+            let (x0, y0) = (bx * LEAF, by * LEAF);
+            for ty in y0..(y0 + LEAF).min(self.height) {
+                for tx in x0..(x0 + LEAF).min(self.width) {
+                    lobe(tx, ty);
+                }
+            }
+        });
+    }
+
+    /// Calls `leaf(bx, by)` for every leaf block (texels [4bx, 4bx + 4) × [4by, 4by + 4))
+    /// whose slope box contains `s`, inside nodes accepted by `node_ok` (as in
+    /// [`SlopeHierarchy::for_each_candidate`]).
+    #[inline]
+    pub fn for_each_leaf(
+        &self,
+        s: [f32; 2],
+        mut node_ok: impl FnMut(usize, usize, usize, usize) -> bool,
+        mut leaf: impl FnMut(usize, usize),
     ) {
         let top = self.levels.len() - 1;
         // Depth-first; at most 3 siblings pending per level plus the current node.
@@ -155,11 +176,7 @@ impl SlopeHierarchy {
                 continue;
             }
             if lv == 0 {
-                for ty in y0..y1 {
-                    for tx in x0..x1 {
-                        lobe(tx, ty);
-                    }
-                }
+                leaf(x as usize, y as usize);
                 continue;
             }
             let child = &self.levels[lv as usize - 1];

@@ -11,6 +11,7 @@
 //! texel-count-weighted average of its children's, so any map size works.
 
 use super::lobe::{LobeF64, SlopeLobe};
+use super::lobe_blocks::LobeBlocks;
 
 /// Moments of a block of the map: mean slope and second moments (xx, xy, yy).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -149,9 +150,9 @@ impl MomentPyramid {
 
     /// Moments of texel (x, y) of level `l` (level 0 from the lobes).
     #[inline]
-    pub fn moments(&self, lobes: &[SlopeLobe], l: usize, x: usize, y: usize) -> Moments {
+    pub fn moments(&self, lobes: &LobeBlocks, l: usize, x: usize, y: usize) -> Moments {
         if l == 0 {
-            return Moments::of_lobe(&lobes[y * self.width + x]);
+            return Moments::of_lobe(&lobes.get(x, y));
         }
         let lv = &self.levels[l - 1];
         Moments::from_f32(lv.texels[y * lv.w + x])
@@ -189,7 +190,7 @@ mod tests {
             let p = MomentPyramid::build(&lobes, w, h);
             let top = p.levels() - 1;
             assert_eq!(p.level_size(top), (1, 1));
-            let m = p.moments(&lobes, top, 0, 0);
+            let m = p.moments(&LobeBlocks::new(&lobes, w, h), top, 0, 0);
             let mut g = Moments::default();
             for l in &lobes {
                 g.add_scaled(&Moments::of_lobe(l), 1.0 / (w * h) as f64);

@@ -13,6 +13,7 @@
 //!   (ERRATA 15);
 //! - [`microsurface`]: seeds and lobe moments (CCM19 §3, ERRATA 14);
 //! - [`hierarchy`]: the (u, slope) bounding-box tree of §5;
+//! - [`lobe_blocks`]: the lobes stored by leaf block, in lanes (the query's inner loop);
 //! - [`mip_levels`]: the moment pyramid of §4.2.2;
 //! - [`footprint`]: the Gaussian footprint k_P and the weights W_i;
 //! - [`patch_ndf`]: D_P (eq. 9) and its sampler;
@@ -31,6 +32,7 @@ pub mod generate;
 pub mod glint_bsdf;
 pub mod hierarchy;
 pub mod lobe;
+pub mod lobe_blocks;
 pub mod microsurface;
 pub mod mip_levels;
 pub mod normal_map;

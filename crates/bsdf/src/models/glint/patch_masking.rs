@@ -366,7 +366,7 @@ mod tests {
                             continue;
                         }
                         let w = (-0.5 * d).exp();
-                        let l = surf.lobes()[(y * 32 + x) as usize].to_f64();
+                        let l = surf.lobes().get(x as usize, y as usize).to_f64();
                         num += w * l.visible_projected_area(v);
                         den += w;
                     }

@@ -25,9 +25,12 @@
 //! Z / K_max ≈ 0.9. For a uniform query the lobe is drawn uniformly.
 
 use super::footprint::{min_quadratic_over_box, FootprintQuery, Weighting};
+use super::hierarchy::LEAF;
 use super::lobe::{normal_of_slope, slope_of_normal, standard_normal_2d, CUTOFF_R2};
+use super::lobe_blocks::{lane_sum, BlockLanes};
 use super::microsurface::SEED_SIGMA;
 use super::surface::GlintSurface;
+use crate::lanes::F32x8;
 use crate::math::rng::RandomSource;
 use crate::math::{Vec2, Vec3};
 use std::sync::OnceLock;
@@ -68,63 +71,97 @@ impl<'a> PatchNdf<'a> {
         self.p22_counting(s).0
     }
 
-    /// P22_P at `s` and the number of lobes evaluated (for the benchmarks and docs).
+    /// P22_P at `s` and the number of lobes evaluated (for the benchmarks and docs): the
+    /// leaf blocks of the hierarchy whose slope box holds `s` and whose texels the
+    /// footprint's truncation may reach, each summed in lanes
+    /// ([`super::lobe_blocks::LobeBlock::accumulate`]; AVX2 registers where the CPU has
+    /// them, the same bits either way).
     pub fn p22_counting(&self, s: [f64; 2]) -> (f64, usize) {
         if !(s[0].is_finite() && s[1].is_finite()) {
             return (0.0, 0);
         }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2::available() {
+            // SAFETY: the CPU has AVX2 and FMA (tested just above).
+            return unsafe { self.p22_avx2(s) };
+        }
+        self.p22_lanes::<F32x8>(s)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn p22_avx2(&self, s: [f64; 2]) -> (f64, usize) {
+        self.p22_lanes::<crate::lanes::F32x8Avx2>(s)
+    }
+
+    #[inline(always)]
+    fn p22_lanes<L: BlockLanes>(&self, s: [f64; 2]) -> (f64, usize) {
         let sf = [s[0] as f32, s[1] as f32];
         let surf = self.surface;
         let q = self.query;
-        let w = surf.width();
-        let mut sum = 0.0;
+        let (w, h) = (surf.width(), surf.height());
+        let mut acc = L::zero();
         let mut touched = 0usize;
+        let lobes_in =
+            |bx: usize, by: usize| ((w - bx * LEAF).min(LEAF)) * ((h - by * LEAF).min(LEAF));
         match q.weighting {
             Weighting::Uniform => {
-                surf.hierarchy.for_each_candidate(
+                surf.hierarchy.for_each_leaf(
                     sf,
                     |_, _, _, _| true,
-                    |x, y| {
-                        touched += 1;
-                        sum += surf.lobes[y * w + x].p22(sf);
+                    |bx, by| {
+                        touched += lobes_in(bx, by);
+                        surf.lobes
+                            .block(bx, by)
+                            .accumulate(sf, [0.0; 2], [0.0; 3], &mut acc);
                     },
                 );
-                (sum * q.weight_scale, touched)
             }
             Weighting::Gaussian => {
-                let (wf, hf) = (w as f64, surf.height() as f64);
+                let (wf, hf) = (w as f64, h as f64);
+                let metric = q.s_inv.map(|v| v as f32);
+                let reach = FootprintQuery::ellipse_half_extent(q.s);
+                let [a, b, c] = q.s_inv;
                 for &(tx, ty) in &q.tiles {
                     let (ox, oy) = (tx as f64 * wf, ty as f64 * hf);
-                    surf.hierarchy.for_each_candidate(
+                    // The footprint's centre and truncation box in this tile's texels.
+                    let (cx, cy) = (q.center.x - ox, q.center.y - oy);
+                    surf.hierarchy.for_each_leaf(
                         sf,
                         |x0, y0, x1, y1| {
-                            min_quadratic_over_box(
-                                q.s_inv,
-                                q.center,
-                                [ox + x0 as f64 + 0.5, ox + x1 as f64 - 0.5],
-                                [oy + y0 as f64 + 0.5, oy + y1 as f64 - 0.5],
-                            ) <= CUTOFF_R2
+                            // Seed centres of the node: [x0 + ½, x1 − ½] × [y0 + ½, y1 − ½].
+                            let (lx, hx) = (x0 as f64 + 0.5, x1 as f64 - 0.5);
+                            let (ly, hy) = (y0 as f64 + 0.5, y1 as f64 - 0.5);
+                            // Outside the truncation ellipse's box: no seed can count.
+                            if hx < cx - reach.x || lx > cx + reach.x {
+                                return false;
+                            }
+                            if hy < cy - reach.y || ly > cy + reach.y {
+                                return false;
+                            }
+                            // The node's centre inside the ellipse: some seed may count.
+                            let (dx, dy) = (0.5 * (lx + hx) - cx, 0.5 * (ly + hy) - cy);
+                            if a * dx * dx + 2.0 * b * dx * dy + c * dy * dy <= CUTOFF_R2 {
+                                return true;
+                            }
+                            min_quadratic_over_box(q.s_inv, Vec2::new(cx, cy), [lx, hx], [ly, hy])
+                                <= CUTOFF_R2
                         },
-                        |x, y| {
-                            touched += 1;
-                            // Both truncation tests first, then one exponential for the
-                            // product P22_i · e^{−m/2} (the hot loop of every query).
-                            let lobe = &surf.lobes[y * w + x];
-                            let ql = lobe.mahalanobis2(sf);
-                            if !(ql <= CUTOFF_R2 as f32) {
-                                return;
-                            }
-                            let u = Vec2::new(ox + x as f64 + 0.5, oy + y as f64 + 0.5);
-                            let m = q.mahalanobis2(u);
-                            if m <= CUTOFF_R2 {
-                                sum += lobe.peak() * (-0.5 * (ql as f64 + m)).exp();
-                            }
+                        |bx, by| {
+                            touched += lobes_in(bx, by);
+                            let d0 = [
+                                ((bx * LEAF) as f64 + 0.5 - cx) as f32,
+                                ((by * LEAF) as f64 + 0.5 - cy) as f32,
+                            ];
+                            surf.lobes
+                                .block(bx, by)
+                                .accumulate(sf, d0, metric, &mut acc);
                         },
                     );
                 }
-                (sum * q.weight_scale, touched)
             }
         }
+        (lane_sum(acc.store()) * q.weight_scale, touched)
     }
 
     /// D_P(ω_h) = P22_P(h̃)/cos⁴θ_h  [CCM19 eq. 2 applied to eq. 9]; 0 below the horizon.
@@ -213,7 +250,7 @@ impl<'a> PatchNdf<'a> {
     /// from it.
     pub fn sample_normal(&self, rng: &mut dyn RandomSource) -> Option<Vec3> {
         let k = self.sample_lobe(rng)?;
-        let lobe = self.surface.lobes[k].to_f64();
+        let lobe = self.surface.lobes.at(k).to_f64();
         Some(normal_of_slope(lobe.sample_slope(rng.next_2d())))
     }
 }
@@ -224,6 +261,35 @@ mod tests {
     use crate::math::rng::Pcg32;
     use crate::models::glint::footprint::Footprint;
     use crate::models::glint::generate::{generate, NormalMapKind};
+
+    #[test]
+    fn the_avx2_and_portable_queries_give_the_same_bits() {
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2::available() {
+            let map = generate(NormalMapKind::Scratched, 64, 3).unwrap();
+            let surf = GlintSurface::build(map, 0.01, "t").unwrap();
+            let mut rng = Pcg32::new(3, 4);
+            let mut nonzero = 0;
+            for (k, sigma) in [0.3, 1.0, 4.0, 12.0, 200.0].into_iter().enumerate() {
+                let fp = Footprint::isotropic(Vec2::new(5.3 + 9.0 * k as f64, 60.8), sigma);
+                let q = FootprintQuery::new(fp, 64, 64);
+                let ndf = PatchNdf::new(&surf, &q);
+                for _ in 0..200 {
+                    let Some(m) = ndf.sample_normal(&mut rng) else {
+                        continue;
+                    };
+                    let s = slope_of_normal(m);
+                    let portable = ndf.p22_lanes::<F32x8>(s);
+                    // SAFETY: AVX2 and FMA are available (tested above).
+                    let avx2 = unsafe { ndf.p22_avx2(s) };
+                    assert_eq!(portable.0.to_bits(), avx2.0.to_bits(), "σ {sigma} s {s:?}");
+                    assert_eq!(portable.1, avx2.1);
+                    nonzero += (avx2.0 > 0.0) as usize;
+                }
+            }
+            assert!(nonzero > 900, "{nonzero}");
+        }
+    }
 
     #[test]
     fn k_max_is_the_lattice_sum_at_a_seed() {

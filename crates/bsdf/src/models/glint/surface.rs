@@ -3,7 +3,7 @@
 //! `Arc`) by every per-shading-point [`super::glint_bsdf::GlintBsdf`].
 
 use super::hierarchy::SlopeHierarchy;
-use super::lobe::SlopeLobe;
+use super::lobe_blocks::LobeBlocks;
 use super::microsurface::{build_lobes, check_roughness_floor};
 use super::mip_levels::MomentPyramid;
 use super::normal_map::NormalMap;
@@ -13,7 +13,7 @@ use std::time::Instant;
 #[derive(Clone, Debug)]
 pub struct GlintSurface {
     pub(crate) map: NormalMap,
-    pub(crate) lobes: Vec<SlopeLobe>,
+    pub(crate) lobes: LobeBlocks,
     pub(crate) hierarchy: SlopeHierarchy,
     pub(crate) pyramid: MomentPyramid,
     roughness_floor: f64,
@@ -43,7 +43,7 @@ impl MemoryReport {
         let per = |b: usize| b as f64 / self.texels as f64;
         [
             ("normal map (2 × f32 slopes)", self.normal_map),
-            ("lobes (5 × f32)", self.lobes),
+            ("lobes (6 × f32, by block)", self.lobes),
             ("slope hierarchy", self.hierarchy),
             ("moment mip levels", self.mip_levels),
             ("total", self.total()),
@@ -67,6 +67,7 @@ impl GlintSurface {
         let lobes = build_lobes(&map, roughness_floor);
         let hierarchy = SlopeHierarchy::build(&lobes, w, h);
         let pyramid = MomentPyramid::build(&lobes, w, h);
+        let lobes = LobeBlocks::new(&lobes, w, h);
         Ok(GlintSurface {
             map,
             lobes,
@@ -90,7 +91,8 @@ impl GlintSurface {
         &self.map
     }
 
-    pub fn lobes(&self) -> &[SlopeLobe] {
+    /// The lobes, by leaf block (texel (x, y) with [`LobeBlocks::get`]).
+    pub fn lobes(&self) -> &LobeBlocks {
         &self.lobes
     }
 
@@ -111,7 +113,7 @@ impl GlintSurface {
         MemoryReport {
             texels: self.map.texels(),
             normal_map: self.map.texels() * 8,
-            lobes: self.lobes.len() * std::mem::size_of::<SlopeLobe>(),
+            lobes: self.lobes.size_bytes(),
             hierarchy: self.hierarchy.size_bytes(),
             mip_levels: self.pyramid.size_bytes(),
         }
