@@ -50,6 +50,9 @@ pub struct GlintBsdf {
     footprint: Footprint,
     /// I_P of the last `wo`: the integrator asks for the same view direction many times.
     cache: Mutex<Option<(Vec3, f64)>>,
+    /// D_P of the last half vector: a light sample's `eval` and `pdf` ask for the same one
+    /// (each query sums the footprint's lobes, the cost of this material).
+    last_d: Mutex<Option<(Vec3, f64)>>,
 }
 
 impl GlintBsdf {
@@ -65,6 +68,7 @@ impl GlintBsdf {
             tint: params.tint,
             footprint,
             cache: Mutex::new(None),
+            last_d: Mutex::new(None),
         }
     }
 
@@ -101,8 +105,18 @@ impl GlintBsdf {
 }
 
 impl PatchReflection for GlintBsdf {
-    /// D_P(h)  [CCM19 eq. 9].
+    /// D_P(h)  [CCM19 eq. 9], remembering the last answer.
     fn d(&self, h: Vec3) -> f64 {
+        if let Ok(mut c) = self.last_d.try_lock() {
+            if let Some((m, d)) = *c {
+                if m == h {
+                    return d;
+                }
+            }
+            let d = self.ndf().d(h);
+            *c = Some((h, d));
+            return d;
+        }
         self.ndf().d(h)
     }
 
