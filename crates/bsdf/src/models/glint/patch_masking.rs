@@ -31,10 +31,13 @@
 
 use super::footprint::{FootprintQuery, Weighting};
 use super::lobe::{expected_positive_part, LobeF64, CUTOFF_R2};
+use super::lobe_blocks::{lane_sum, BlockLanes};
 use super::microsurface::SEED_SIGMA;
 use super::mip_levels::{block_extent, Moments};
 use super::surface::GlintSurface;
 use crate::error::{ParamError, ParamResult};
+use crate::lanes::{F32x8, Mask, Real};
+use crate::math::special::erfc_lanes;
 use crate::math::{Vec2, Vec3, PI};
 
 /// Default budget of lobes summed by the exact masking term.
@@ -184,11 +187,48 @@ pub fn for_each_block(
 /// Σxy, Σyy, weight.
 type WeightedLobe = [f64; 6];
 
+/// Eight weighted lobes side by side, for the sum of [`PatchMasking::visible_projected_area`]:
+/// mean slope, covariance (xx, xy, yy) and normalized weight (0 in unused lanes).
+#[derive(Clone, Copy, Debug)]
+struct LobeLanes {
+    mx: F32x8,
+    my: F32x8,
+    xx: F32x8,
+    xy: F32x8,
+    yy: F32x8,
+    w: F32x8,
+}
+
+impl LobeLanes {
+    fn of(lobes: &[WeightedLobe]) -> Vec<LobeLanes> {
+        lobes
+            .chunks(8)
+            .map(|c| {
+                let lane = |k: usize| {
+                    F32x8(std::array::from_fn(|j| {
+                        c.get(j).map_or(0.0, |e| e[k] as f32)
+                    }))
+                };
+                LobeLanes {
+                    mx: lane(0),
+                    my: lane(1),
+                    xx: lane(2),
+                    xy: lane(3),
+                    yy: lane(4),
+                    w: lane(5),
+                }
+            })
+            .collect()
+    }
+}
+
 /// The masking term of one footprint.
 #[derive(Clone, Debug)]
 pub struct PatchMasking {
     mode: MaskingMode,
     lobes: Vec<WeightedLobe>,
+    /// The same lobes in lanes (what I_P sums).
+    lanes: Vec<LobeLanes>,
     level: usize,
 }
 
@@ -206,6 +246,7 @@ impl PatchMasking {
         normalize(&mut lobes, total);
         PatchMasking {
             mode: MaskingMode::Exact,
+            lanes: LobeLanes::of(&lobes),
             lobes,
             level,
         }
@@ -229,9 +270,11 @@ impl PatchMasking {
             }
         };
         let l = m.lobe();
+        let lobes = vec![[l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], 1.0]];
         PatchMasking {
             mode: MaskingMode::Approx,
-            lobes: vec![[l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], 1.0]],
+            lanes: Vec::new(),
+            lobes,
             level,
         }
     }
@@ -276,9 +319,48 @@ impl PatchMasking {
     }
 
     /// I_P(v) = ∫ ⟨v, m⟩ D_P(m) dω_m  [CCM19 eq. 12 denominator] (exact), or the single
-    /// lobe's A(1 + Λ) (approximate). `v` in the upper hemisphere.
+    /// lobe's A(1 + Λ) (approximate). `v` in the upper hemisphere. The exact sum runs in
+    /// `f32` lanes (AVX2 where the CPU has it, the same bits; [`expected_positive_part_lanes`]),
+    /// within 2e-5 (relative) of [`PatchMasking::visible_projected_area_f64`] (tested);
+    /// the single lobe of the approximate term in `f64`.
     #[inline]
     pub fn visible_projected_area(&self, v: Vec3) -> f64 {
+        if self.lanes.is_empty() {
+            return self.visible_projected_area_f64(v);
+        }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2::available() {
+            // SAFETY: the CPU has AVX2 and FMA (tested just above).
+            return unsafe { self.area_avx2(v) };
+        }
+        self.area_lanes::<F32x8>(v)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn area_avx2(&self, v: Vec3) -> f64 {
+        self.area_lanes::<crate::lanes::F32x8Avx2>(v)
+    }
+
+    #[inline(always)]
+    fn area_lanes<L: BlockLanes>(&self, v: Vec3) -> f64 {
+        let (vx, vy, vz) = (L::splat(v.x), L::splat(v.y), L::splat(v.z));
+        let (vxx, vxy, vyy) = (
+            L::splat(v.x * v.x),
+            L::splat(2.0 * v.x * v.y),
+            L::splat(v.y * v.y),
+        );
+        let mut acc = L::zero();
+        for e in &self.lanes {
+            let d = vz - vx * L::load(&e.mx) - vy * L::load(&e.my);
+            let s2 = vxx * L::load(&e.xx) + vxy * L::load(&e.xy) + vyy * L::load(&e.yy);
+            acc = acc + L::load(&e.w) * expected_positive_part_lanes(d, s2.max(L::zero()).sqrt());
+        }
+        lane_sum(acc.store())
+    }
+
+    /// I_P(v) summed in `f64` lobe by lobe (the reference of the lanes' sum).
+    pub fn visible_projected_area_f64(&self, v: Vec3) -> f64 {
         let mut sum = 0.0;
         for e in &self.lobes {
             let d = v.z - v.x * e[0] - v.y * e[1];
@@ -315,6 +397,26 @@ impl PatchMasking {
     }
 }
 
+/// E[X⁺] for X ~ N(d, s²) over lanes: s φ(d/s) + d Φ(d/s) (d⁺ where s = 0), with Φ from
+/// [`erfc_lanes`] — the lanes' form of [`expected_positive_part`]. For a lobe facing away
+/// (d < 0) the two terms cancel, and in `f32` the relative error grows with |ν| (ν = d/s):
+/// measured below 2.7e-5 for ν ≥ −4 and 1.5e-3 for −12 ≤ ν < −4, where the lobe's value
+/// is below e^{−8} of its width.
+#[inline(always)]
+pub fn expected_positive_part_lanes<L: Real>(d: L, s: L) -> L {
+    let has_width = s.gt(L::splat(1e-30));
+    let nu = d / L::select(has_width, s, L::one());
+    // ν ≥ 5.8: Φ(ν) = 1 − 3e-9 and s φ(ν) = 1e-8 d, below f32's resolution of d — the
+    // common case (narrow lobes facing v) costs no exponential.
+    if (nu.ge(L::splat(5.8)) | !has_width).all() {
+        return d.max(L::zero());
+    }
+    let phi = (L::splat(-0.5) * nu * nu).exp() * L::splat(1.0 / (2.0 * PI).sqrt());
+    let cdf = L::splat(0.5) * erfc_lanes(-nu * L::splat(std::f64::consts::FRAC_1_SQRT_2));
+    let e = L::select(has_width, s * phi + d * cdf, d);
+    e.max(L::zero())
+}
+
 fn normalize(lobes: &mut [WeightedLobe], total: f64) {
     if total > 0.0 {
         for e in lobes.iter_mut() {
@@ -328,6 +430,59 @@ mod tests {
     use super::*;
     use crate::models::glint::footprint::Footprint;
     use crate::models::glint::generate::{generate, NormalMapKind};
+
+    #[test]
+    fn the_lanes_sum_is_the_f64_sum() {
+        let map = generate(NormalMapKind::Bumpy, 64, 5).unwrap();
+        let surf = GlintSurface::build(map, 0.01, "t").unwrap();
+        let mut worst: f64 = 0.0;
+        for (k, sigma) in [0.5, 3.0, 9.0].into_iter().enumerate() {
+            let q = FootprintQuery::new(
+                Footprint::isotropic(Vec2::new(10.3 + 17.0 * k as f64, 40.7), sigma),
+                64,
+                64,
+            );
+            let m = PatchMasking::exact(&surf, &q, 0);
+            for t in 0..40 {
+                let theta = 0.9999 * std::f64::consts::FRAC_PI_2 * (t as f64 / 39.0).sqrt();
+                let v = crate::math::spherical_direction(theta, 0.77 * t as f64);
+                let (a, b) = (m.visible_projected_area(v), m.visible_projected_area_f64(v));
+                worst = worst.max((a - b).abs() / b.max(1e-30));
+                #[cfg(target_arch = "x86_64")]
+                if crate::lanes::avx2::available() {
+                    // SAFETY: AVX2 and FMA are available (tested above).
+                    let c = unsafe { m.area_avx2(v) };
+                    assert_eq!(c.to_bits(), m.area_lanes::<F32x8>(v).to_bits());
+                }
+            }
+        }
+        println!("I_P in lanes against f64: largest relative difference {worst:.1e}");
+        assert!(worst < 2e-5, "relative difference {worst}");
+    }
+
+    #[test]
+    fn expected_positive_part_in_lanes_follows_the_f64_one() {
+        // Largest relative error for ν ≥ −4 and for ν < −4 (printed: docs and comments).
+        let mut worst = [0.0f64; 2];
+        for i in 0..=400 {
+            let nu = -12.0 + 0.06 * i as f64;
+            for s in [1e-3, 0.3, 2.0] {
+                let d = nu * s;
+                let f = expected_positive_part(d, s);
+                let l = expected_positive_part_lanes(F32x8::splat(d), F32x8::splat(s)).0[0] as f64;
+                let tol = 1e-6 * (1.0 + nu.min(0.0).powi(4)) * f + 1e-37;
+                let k = (nu < -4.0) as usize;
+                worst[k] = worst[k].max((l - f).abs() / f);
+                assert!((l - f).abs() <= tol, "ν {nu} s {s}: {l} vs {f}");
+            }
+        }
+        println!(
+            "relative error: ν ≥ −4 {:.1e}, −12 ≤ ν < −4 {:.1e}",
+            worst[0], worst[1]
+        );
+        let z = expected_positive_part_lanes(F32x8::splat(0.5), F32x8::zero()).0[0];
+        assert_eq!(z, 0.5);
+    }
 
     #[test]
     fn a_flat_map_has_beckmann_masking() {
@@ -373,7 +528,10 @@ mod tests {
                 }
             }
         }
-        let i = m.visible_projected_area(v);
+        // The f64 sum to rounding; the lanes' f32 sum to its precision.
+        let i = m.visible_projected_area_f64(v);
         assert!((i - num / den).abs() < 1e-12, "{i} {}", num / den);
+        let i = m.visible_projected_area(v);
+        assert!((i - num / den).abs() < 1e-6 * i, "{i} {}", num / den);
     }
 }
