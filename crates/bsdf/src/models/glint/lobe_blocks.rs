@@ -62,28 +62,6 @@ impl LobeBlock {
         }
     }
 
-    /// The seed weights e^{−½ m_j} of the block's texels (lane j as in the module notes), 0
-    /// for a seed outside the truncation m_j > R² and for the lanes past the map's edge
-    /// (`d0` and `b` as in [`LobeBlock::accumulate`]).
-    pub fn seed_weights(&self, d0: [f32; 2], b: [f32; 3]) -> [f32; BLOCK] {
-        let mut out = [0.0; BLOCK];
-        for h in 0..2 {
-            let m = seed_metric(h, d0, b);
-            for k in 0..8 {
-                if !self.mean_x[h].0[k].is_nan() && m.0[k] <= CUTOFF_R2 as f32 {
-                    out[8 * h + k] = (-0.5 * m.0[k]).exp();
-                }
-            }
-        }
-        out
-    }
-
-    /// The lobe of lane j.
-    #[inline]
-    pub fn lobe(&self, j: usize) -> SlopeLobe {
-        self.get(j)
-    }
-
     /// Adds to `acc`, lane by lane, P22_j(s) · e^{−½ m_j} for the block's lobes j whose
     /// slope truncation (m̃ − μ_j)ᵀΣ_j⁻¹(m̃ − μ_j) ≤ R² and seed truncation m_j ≤ R² both
     /// hold, with m_j = d_jᵀ B d_j the seed's squared distance (metric `b`) from the
@@ -141,18 +119,12 @@ impl BlockLanes for crate::lanes::F32x8Avx2 {
     }
 }
 
-/// m_j = d_jᵀ B d_j for the lanes of half `h` of a block (the one expression both the
-/// query and the seed weights use, so that they agree on the truncation bit for bit).
+/// m_j = d_jᵀ B d_j for the lanes of half `h` of a block.
 #[inline(always)]
 fn seed_metric_lanes<L: BlockLanes>(h: usize, d0: [f32; 2], ba: L, bb: L, bc: L) -> L {
     let dx = L::splat(d0[0] as f64) + L::load(&LANE_X);
     let dy = L::splat(d0[1] as f64 + 2.0 * h as f64) + L::load(&LANE_Y);
     ba * dx * dx + (bb + bb) * dx * dy + bc * dy * dy
-}
-
-fn seed_metric(h: usize, d0: [f32; 2], b: [f32; 3]) -> F32x8 {
-    let [ba, bb, bc] = b.map(|v| F32x8::splat(v as f64));
-    seed_metric_lanes(h, d0, ba, bb, bc)
 }
 
 /// Every lobe of a map, by leaf block (row-major blocks).
