@@ -123,29 +123,10 @@ impl SlopeHierarchy {
         self.levels.last().map(|l| l.boxes[0]).unwrap_or(EMPTY)
     }
 
-    /// Calls `lobe(x, y)` for every texel whose lobe's slope box may contain `s`, inside
-    /// nodes accepted by `node_ok(x0, y0, x1, y1)` (a half-open texel range). `node_ok` must be
-    /// conservative: reject a node only when no texel of its range can contribute.
-    #[inline]
-    pub fn for_each_candidate(
-        &self,
-        s: [f32; 2],
-        node_ok: impl FnMut(usize, usize, usize, usize) -> bool,
-        mut lobe: impl FnMut(usize, usize),
-    ) {
-        self.for_each_leaf(s, node_ok, |bx, by| {
-            let (x0, y0) = (bx * LEAF, by * LEAF);
-            for ty in y0..(y0 + LEAF).min(self.height) {
-                for tx in x0..(x0 + LEAF).min(self.width) {
-                    lobe(tx, ty);
-                }
-            }
-        });
-    }
-
     /// Calls `leaf(bx, by)` for every leaf block (texels [4bx, 4bx + 4) × [4by, 4by + 4))
-    /// whose slope box contains `s`, inside nodes accepted by `node_ok` (as in
-    /// [`SlopeHierarchy::for_each_candidate`]).
+    /// whose slope box contains `s`, inside nodes accepted by `node_ok(x0, y0, x1, y1)` (a
+    /// half-open texel range). `node_ok` must be conservative: reject a node only when no
+    /// texel of its range can contribute.
     #[inline]
     pub fn for_each_leaf(
         &self,
@@ -214,7 +195,17 @@ mod tests {
                 ((q as f32) * 0.13).cos() * 0.6,
             ];
             let mut found = vec![false; w * h];
-            tree.for_each_candidate(s, |_, _, _, _| true, |x, y| found[y * w + x] = true);
+            tree.for_each_leaf(
+                s,
+                |_, _, _, _| true,
+                |bx, by| {
+                    for y in by * LEAF..((by + 1) * LEAF).min(h) {
+                        for x in bx * LEAF..((bx + 1) * LEAF).min(w) {
+                            found[y * w + x] = true;
+                        }
+                    }
+                },
+            );
             for (k, l) in lobes.iter().enumerate() {
                 if l.mahalanobis2(s) <= CUTOFF_R2 as f32 {
                     assert!(found[k], "lobe {k} missed for {s:?}");

@@ -75,7 +75,10 @@ impl LobeBlock {
         let (sx, sy) = (L::splat(s[0] as f64), L::splat(s[1] as f64));
         let [ba, bb, bc] = b.map(|v| L::splat(v as f64));
         for h in 0..2 {
-            let m = seed_metric_lanes(h, d0, ba, bb, bc);
+            // The seeds' squared distance from the footprint centre, m_j = d_jᵀ B d_j.
+            let dx = L::splat(d0[0] as f64) + L::load(&LANE_X);
+            let dy = L::splat(d0[1] as f64 + 2.0 * h as f64) + L::load(&LANE_Y);
+            let m = ba * dx * dx + (bb + bb) * dx * dy + bc * dy * dy;
             let ex = sx - L::load(&self.mean_x[h]);
             let ey = sy - L::load(&self.mean_y[h]);
             let bxy = L::load(&self.b[h]);
@@ -117,14 +120,6 @@ impl BlockLanes for crate::lanes::F32x8Avx2 {
     fn store(self) -> F32x8 {
         F32x8(self.to_array())
     }
-}
-
-/// m_j = d_jᵀ B d_j for the lanes of half `h` of a block.
-#[inline(always)]
-fn seed_metric_lanes<L: BlockLanes>(h: usize, d0: [f32; 2], ba: L, bb: L, bc: L) -> L {
-    let dx = L::splat(d0[0] as f64) + L::load(&LANE_X);
-    let dy = L::splat(d0[1] as f64 + 2.0 * h as f64) + L::load(&LANE_Y);
-    ba * dx * dx + (bb + bb) * dx * dy + bc * dy * dy
 }
 
 /// Every lobe of a map, by leaf block (row-major blocks).

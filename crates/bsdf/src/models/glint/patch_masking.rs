@@ -200,25 +200,30 @@ struct LobeLanes {
 }
 
 impl LobeLanes {
+    const EMPTY: LobeLanes = LobeLanes {
+        mx: F32x8([0.0; 8]),
+        my: F32x8([0.0; 8]),
+        xx: F32x8([0.0; 8]),
+        xy: F32x8([0.0; 8]),
+        yy: F32x8([0.0; 8]),
+        w: F32x8([0.0; 8]),
+    };
+
+    /// The lanes of `lobes`, in order (unused lanes weigh 0).
     fn of(lobes: &[WeightedLobe]) -> Vec<LobeLanes> {
-        lobes
-            .chunks(8)
-            .map(|c| {
-                let lane = |k: usize| {
-                    F32x8(std::array::from_fn(|j| {
-                        c.get(j).map_or(0.0, |e| e[k] as f32)
-                    }))
-                };
-                LobeLanes {
-                    mx: lane(0),
-                    my: lane(1),
-                    xx: lane(2),
-                    xy: lane(3),
-                    yy: lane(4),
-                    w: lane(5),
-                }
-            })
-            .collect()
+        let mut out = vec![LobeLanes::EMPTY; lobes.len().div_ceil(8)];
+        for (k, e) in lobes.iter().enumerate() {
+            let (c, j) = (&mut out[k / 8], k % 8);
+            for (field, v) in [
+                &mut c.mx, &mut c.my, &mut c.xx, &mut c.xy, &mut c.yy, &mut c.w,
+            ]
+            .into_iter()
+            .zip(e)
+            {
+                field.0[j] = *v as f32;
+            }
+        }
+        out
     }
 }
 
