@@ -11,7 +11,7 @@ use crate::error::{ParamError, ParamResult};
 use crate::math::spectrum::{Spectrum, CHANNELS};
 
 /// Which ends of an interval are included.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Bounds {
     /// (lo, hi)
     Open,

@@ -11,6 +11,7 @@
 pub mod material;
 pub mod microfacet;
 pub mod params;
+pub mod schema;
 
 pub use material::glint::{DecodedImage, GlintRecipe, NormalMapReader};
 pub use material::{
