@@ -10,12 +10,33 @@
 #      `test` extra (pytest, Ray, matplotlib; numpy): the wheel installs as a user would
 #      install it, without Rust.
 #   4. pytest on crates/python/tests with that environment's Python.
+#   5. The explorer's browser tests (crates/explore/tests/browser): Debian's chromium and
+#      chromium-driver, installed with apt-get when missing (as root, or through sudo),
+#      in the background while the crates compile; selenium from PyPI into the same
+#      environment. Screenshots and latency figures go to target/explore-artefacts/.
 #
 # FACETTE_TEST_VENV overrides the environment's folder.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
 venv="${FACETTE_TEST_VENV:-$CARGO_TARGET_DIR/test-venv}"
+
+# The browser, installed while the crates compile (its log in target/browser-install.log).
+mkdir -p "$CARGO_TARGET_DIR"
+browser_log="$CARGO_TARGET_DIR/browser-install.log"
+install_browser() {
+    if command -v chromium >/dev/null && command -v chromedriver >/dev/null; then
+        return 0
+    fi
+    local sudo=""
+    if [ "$(id -u)" != 0 ]; then
+        command -v sudo >/dev/null || { echo "chromium and chromium-driver are missing, and installing them needs root or sudo"; return 1; }
+        sudo="sudo -n"
+    fi
+    $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq chromium chromium-driver
+}
+install_browser >"$browser_log" 2>&1 &
+browser_install=$!
 
 cargo test --workspace --profile optimized-tests
 
@@ -33,3 +54,13 @@ wheel=$(echo "$wheels"/facette-*.whl)
 "$py" -m pip install --quiet "$wheel[test]"
 
 "$py" -m pytest -q crates/python/tests
+
+if ! wait "$browser_install"; then
+    echo "error: installing chromium and chromium-driver failed (see $browser_log):" >&2
+    tail -n 20 "$browser_log" >&2
+    exit 1
+fi
+"$py" -m pip install --quiet selenium
+FACETTE_BIN="$CARGO_TARGET_DIR/optimized-tests/facette" \
+    FACETTE_ARTEFACTS="$CARGO_TARGET_DIR/explore-artefacts" \
+    "$py" -m pytest -q crates/explore/tests/browser

@@ -3,6 +3,7 @@
 
 mod cmd_albedo;
 mod cmd_eval;
+mod cmd_explore;
 mod cmd_fit;
 mod cmd_il_approx;
 mod cmd_measure;
@@ -90,6 +91,8 @@ enum Command {
     Reproduce(cmd_reproduce::ReproduceArgs),
     /// Normal maps for the glint material (CCM19): generate the kinds of CCM19 Fig. 7.
     Normalmap(cmd_normalmap::NormalMapArgs),
+    /// The interactive BRDF explorer: a local web server; open the URL it prints.
+    Explore(cmd_explore::ExploreArgs),
 }
 
 /// Output piped into a reader that stops early (`facette eval … | head`) is not an error:
@@ -135,6 +138,7 @@ fn main() -> ExitCode {
         Command::Measure(a) => cmd_measure::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
         Command::Normalmap(a) => cmd_normalmap::run(a),
+        Command::Explore(a) => cmd_explore::run(a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,283 @@
+//! The HTTP server: static assets, the schema, and one POST route per view. Requests are
+//! evaluated on blocking threads (the computation itself is parallel, on rayon's pool);
+//! a request the app abandons is cancelled. By default the server binds to 127.0.0.1 and
+//! refuses any request that is not from the loopback interface or whose `Host` is not a
+//! loopback name (a web page elsewhere cannot reach it by DNS rebinding); `--host` lifts
+//! both. It writes no files.
+
+use crate::assets::asset;
+use crate::cancel::Cancel;
+use crate::frame::Frame;
+use crate::material::{Material, MaterialCache};
+use crate::schema_json::schema_json;
+use crate::views::{self, AlbedoRequest, HemisphereRequest, SliceRequest};
+use anyhow::{Context, Result};
+use axum::body::Body;
+use axum::extract::{ConnectInfo, Request, State};
+use axum::http::{header, StatusCode, Uri};
+use axum::middleware::{self, Next};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::Deserialize;
+use serde_json::json;
+use std::net::SocketAddr;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// What `facette explore` was asked for.
+#[derive(Clone, Debug, Default)]
+pub struct ExploreOptions {
+    /// Address to bind; `None`: 127.0.0.1, loopback requests only.
+    pub host: Option<String>,
+    /// 0: any free port.
+    pub port: u16,
+    /// Materials the app opens with (TOML inline tables).
+    pub materials: Vec<String>,
+}
+
+struct AppState {
+    cache: MaterialCache,
+    initial: Vec<String>,
+}
+
+type Shared = Arc<AppState>;
+
+/// What the app opens with when no `--material` is given: a rough gold and an interfaced
+/// Lambertian plastic in IL18's closed form (both deterministic and fast to evaluate).
+pub const DEFAULT_MATERIALS: &[&str] = &[
+    r#"{type = "conductor", distribution = "ggx", alpha = 0.2, material = "Au"}"#,
+    r#"{type = "il", kd = [0.6, 0.25, 0.1], ni = 1.5, distribution = "beckmann", alpha = 0.3, evaluation = "approx"}"#,
+];
+
+/// Builds the initial materials (an error names the bad one), binds, calls `on_ready` with
+/// the address, and serves until Ctrl-C (or `shutdown` resolves).
+pub fn serve(
+    options: ExploreOptions,
+    on_ready: impl FnOnce(SocketAddr) + Send,
+    shutdown: impl std::future::Future<Output = ()> + Send + 'static,
+) -> Result<()> {
+    let mut initial = Vec::new();
+    let defaults: Vec<String> = DEFAULT_MATERIALS.iter().map(|s| s.to_string()).collect();
+    let given = if options.materials.is_empty() {
+        &defaults
+    } else {
+        &options.materials
+    };
+    for m in given {
+        let built =
+            crate::material::build(m).map_err(|e| anyhow::anyhow!("--material `{m}`: {e}"))?;
+        initial.push(built.text);
+    }
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the server's runtime")?;
+    runtime.block_on(async move {
+        let host = options.host.clone().unwrap_or_else(|| "127.0.0.1".into());
+        let listener = tokio::net::TcpListener::bind((host.as_str(), options.port))
+            .await
+            .with_context(|| {
+                format!(
+                    "cannot listen on {host}:{} (another program on that port? `--port 0` picks a free one)",
+                    options.port
+                )
+            })?;
+        let addr = listener.local_addr()?;
+        on_ready(addr);
+        let state = Arc::new(AppState {
+            cache: MaterialCache::default(),
+            initial,
+        });
+        let app = router(state, options.host.is_none());
+        axum::serve(
+            listener,
+            app.into_make_service_with_connect_info::<SocketAddr>(),
+        )
+        .with_graceful_shutdown(async move {
+            tokio::select! {
+                _ = tokio::signal::ctrl_c() => {}
+                _ = shutdown => {}
+            }
+        })
+        .await
+        .context("serving")
+    })
+}
+
+fn router(state: Shared, local_only: bool) -> Router {
+    let app = Router::new()
+        .route("/api/schema", get(|| async { Json(schema_json()) }))
+        .route("/api/initial", get(initial))
+        .route("/api/material", post(material))
+        .route("/api/slice", post(slice))
+        .route("/api/hemisphere", post(hemisphere))
+        .route("/api/albedo", post(albedo))
+        .fallback(get(static_asset))
+        .with_state(state);
+    if local_only {
+        app.layer(middleware::from_fn(loopback_only))
+    } else {
+        app
+    }
+}
+
+/// Whether a `Host` header names this machine (`localhost`, `127.0.0.1`, `[::1]`, with
+/// any port).
+pub fn is_loopback_host(host: &str) -> bool {
+    let name = match host.strip_prefix('[') {
+        Some(v6) => v6.split(']').next().unwrap_or(""),
+        None => host.rsplit_once(':').map_or(host, |(h, _)| h),
+    };
+    name.eq_ignore_ascii_case("localhost")
+        || name
+            .parse::<std::net::IpAddr>()
+            .is_ok_and(|ip| ip.is_loopback())
+}
+
+async fn loopback_only(
+    ConnectInfo(peer): ConnectInfo<SocketAddr>,
+    request: Request,
+    next: Next,
+) -> Response {
+    let host_ok = request
+        .headers()
+        .get(header::HOST)
+        .and_then(|h| h.to_str().ok())
+        .is_some_and(is_loopback_host);
+    if !peer.ip().is_loopback() || !host_ok {
+        return (
+            StatusCode::FORBIDDEN,
+            "facette explore answers this machine only (start it with --host to serve others)\n",
+        )
+            .into_response();
+    }
+    next.run(request).await
+}
+
+async fn static_asset(uri: Uri) -> Response {
+    if uri.path() == "/favicon.ico" {
+        return StatusCode::NO_CONTENT.into_response();
+    }
+    match asset(uri.path()) {
+        Some((ty, body)) => ([(header::CONTENT_TYPE, ty)], body).into_response(),
+        None => (StatusCode::NOT_FOUND, format!("no {}\n", uri.path())).into_response(),
+    }
+}
+
+async fn initial(State(s): State<Shared>) -> Json<serde_json::Value> {
+    Json(json!({ "materials": s.initial }))
+}
+
+fn error(status: StatusCode, message: impl Into<String>) -> Response {
+    (status, Json(json!({ "error": message.into() }))).into_response()
+}
+
+#[derive(Deserialize)]
+struct MaterialRequest {
+    material: String,
+}
+
+/// Parses and builds a material: its canonical text and what it is, or the grammar's error.
+async fn material(State(s): State<Shared>, Json(q): Json<MaterialRequest>) -> Response {
+    let built = tokio::task::spawn_blocking(move || s.cache.get(&q.material)).await;
+    match built {
+        Ok(Ok(m)) => Json(json!({
+            "text": m.text,
+            "table": m.table,
+            "describe": m.bsdf.describe(),
+            "stochastic": m.bsdf.is_stochastic(),
+        }))
+        .into_response(),
+        Ok(Err(e)) => error(StatusCode::UNPROCESSABLE_ENTITY, e),
+        Err(e) => error(
+            StatusCode::INTERNAL_SERVER_ERROR,
+            format!("internal error: {e}"),
+        ),
+    }
+}
+
+/// Runs a view on a blocking thread: builds the material (422 with the grammar's error),
+/// computes (cancelled if the request is dropped), and answers the encoded frame with the
+/// computation's time in `compute_ms`.
+async fn run_view(
+    s: Shared,
+    text: String,
+    check: Result<(), String>,
+    view: impl FnOnce(&Material, &Cancel) -> Option<Frame> + Send + 'static,
+) -> Response {
+    if let Err(e) = check {
+        return error(StatusCode::BAD_REQUEST, e);
+    }
+    let cancel = Cancel::default();
+    let guard = cancel.guard();
+    let done = tokio::task::spawn_blocking(move || {
+        let m = s.cache.get(&text)?;
+        let start = Instant::now();
+        Ok::<_, String>(
+            view(&m, &cancel).map(|f| f.field("compute_ms", start.elapsed().as_secs_f64() * 1e3)),
+        )
+    })
+    .await;
+    guard.disarm();
+    match done {
+        Ok(Ok(Some(frame))) => Response::builder()
+            .header(header::CONTENT_TYPE, "application/octet-stream")
+            .body(Body::from(frame.encode()))
+            .unwrap_or_else(|e| error(StatusCode::INTERNAL_SERVER_ERROR, e.to_string())),
+        Ok(Ok(None)) => error(StatusCode::SERVICE_UNAVAILABLE, "cancelled"),
+        Ok(Err(e)) => error(StatusCode::UNPROCESSABLE_ENTITY, e),
+        Err(e) => error(
+            StatusCode::INTERNAL_SERVER_ERROR,
+            format!("internal error while evaluating: {e}"),
+        ),
+    }
+}
+
+async fn slice(State(s): State<Shared>, Json(q): Json<SliceRequest>) -> Response {
+    run_view(s, q.material.clone(), q.check(), move |m, c| {
+        views::slice(&*m.bsdf, &m.text, &q, c)
+    })
+    .await
+}
+
+async fn hemisphere(State(s): State<Shared>, Json(q): Json<HemisphereRequest>) -> Response {
+    run_view(s, q.material.clone(), q.check(), move |m, c| {
+        views::hemisphere(&*m.bsdf, &m.text, &q, c)
+    })
+    .await
+}
+
+async fn albedo(State(s): State<Shared>, Json(q): Json<AlbedoRequest>) -> Response {
+    run_view(s, q.material.clone(), q.check(), move |m, c| {
+        views::albedo(&*m.bsdf, &m.text, &q, c)
+    })
+    .await
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn loopback_hosts() {
+        for h in [
+            "localhost",
+            "localhost:8470",
+            "127.0.0.1:1",
+            "[::1]:80",
+            "127.0.0.2",
+        ] {
+            assert!(is_loopback_host(h), "{h}");
+        }
+        for h in [
+            "example.com",
+            "evil.localhost.example:80",
+            "10.0.0.1:8470",
+            "[2001:db8::1]:80",
+        ] {
+            assert!(!is_loopback_host(h), "{h}");
+        }
+    }
+}

@@ -1,0 +1,198 @@
+"""End-to-end tests of `facette explore` in a real headless Chromium (selenium).
+
+Run by scripts/test.sh, which installs Debian's chromium and chromium-driver and builds the
+binary: FACETTE_BIN names it, FACETTE_ARTEFACTS the folder for the screenshots and the
+latency figures. The numbers the page draws are checked against `facette eval` for the
+same material, and a bad value must show the grammar's own error message.
+"""
+
+import json
+import math
+import os
+import re
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("SE_OFFLINE", "true")  # never let selenium fetch a driver
+from selenium import webdriver  # noqa: E402
+from selenium.webdriver.chrome.service import Service  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[4]
+BIN = Path(os.environ.get("FACETTE_BIN", ROOT / "target" / "optimized-tests" / "facette"))
+ARTEFACTS = Path(os.environ.get("FACETTE_ARTEFACTS", ROOT / "target" / "explore-artefacts"))
+GOLD = '{type = "conductor", distribution = "ggx", alpha = 0.2, material = "Au"}'
+PLASTIC = '{type = "il", kd = 0.5, ni = 1.5, distribution = "beckmann", alpha = 0.3, evaluation = "approx"}'
+
+
+@pytest.fixture(scope="module")
+def server():
+    proc = subprocess.Popen(
+        [str(BIN), "explore", "--port", "0", "--material", GOLD, "--material", PLASTIC],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    line = proc.stdout.readline()
+    m = re.search(r"http://\S+/", line)
+    assert m, f"no URL in {line!r}; stderr: {proc.stderr.read() if proc.poll() is not None else ''}"
+    yield m.group(0)
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def driver():
+    o = webdriver.ChromeOptions()
+    o.binary_location = "/usr/bin/chromium"
+    for a in [
+        "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+        "--no-first-run", "--disable-background-networking", "--disable-component-update",
+        "--disable-sync", "--window-size=1500,1000",
+    ]:
+        o.add_argument(a)
+    d = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=o)
+    yield d
+    d.quit()
+
+
+def settle(d, timeout=30.0):
+    """Waits until the page has no debounce pending and no request in flight."""
+    end = time.time() + timeout
+    while time.time() < end:
+        if d.execute_script("return !!(window.explorer && window.explorer.materials.length && window.explorer.settled())"):
+            return
+        time.sleep(0.02)
+    raise AssertionError("the page did not settle")
+
+
+def eval_rows(material, rows):
+    """`facette eval` of (theta_i, phi_i, theta_o, phi_o) rows: (r, g, b) per row."""
+    csv = "".join(f"{a},{b},{c},{e}\n" for a, b, c, e in rows)
+    out = subprocess.run([str(BIN), "eval", "--material", material], input=csv,
+                         capture_output=True, text=True, check=True).stdout
+    return [tuple(float(x) for x in line.split(",")[4:7]) for line in out.splitlines()[1:]]
+
+
+def plane_rows(theta_i, angles):
+    """The lab's signed incidence-plane angle as eval's (theta_o, phi_o): + is the mirror side."""
+    return [(theta_i, 0.0, abs(t), 180.0 if t > 0 else 0.0) for t in angles]
+
+
+def close(a, b):
+    return abs(a - b) <= 1e-8 * max(abs(a), abs(b)) + 1e-12
+
+
+def slice_of(d, k):
+    return d.execute_script(
+        "const m = window.explorer.materials[arguments[0]]; const f = window.explorer.data.slice[m.id];"
+        "return {text: f.material, theta: Array.from(f.data.theta_o), g: Array.from(f.data.reflect_g),"
+        " drawn: window.explorer.drawn.slice.filter(s => s.material === m.id && s.side === 'reflect')[0].y};", k)
+
+
+def check_slice_against_eval(d, k, theta_i):
+    s = slice_of(d, k)
+    picks = [i for i, t in enumerate(s["theta"]) if abs(t) < 89.0][::24]
+    ref = eval_rows(s["text"], plane_rows(theta_i, [s["theta"][i] for i in picks]))
+    for i, (r, g, b) in zip(picks, ref):
+        assert close(s["g"][i], g), (s["theta"][i], s["g"][i], g)
+    return s
+
+
+def move(d, selector, value, event="input"):
+    d.execute_script(
+        "const e = document.querySelector(arguments[0]); e.focus(); e.value = arguments[1];"
+        "e.dispatchEvent(new Event(arguments[2], {bubbles: true}));", selector, str(value), event)
+
+
+def test_the_views_show_what_eval_computes_and_follow_the_controls(server, driver):
+    d = driver
+    d.get(server)
+    settle(d)
+    assert d.execute_script("return window.explorer.errors") == []
+    texts = d.execute_script("return window.explorer.materials.map(m => m.type)")
+    assert texts == ["conductor", "il"]
+
+    before = check_slice_against_eval(d, 0, 30.0)
+    check_slice_against_eval(d, 1, 30.0)
+
+    # A slider moves alpha: the material's text and every number follow.
+    move(d, 'input[data-material="0"][data-key="alpha"][data-role="slider"]', 0.4)
+    settle(d)
+    after = check_slice_against_eval(d, 0, 30.0)
+    assert "alpha = 0.4" in after["text"], after["text"]
+    assert max(after["g"]) < 0.5 * max(before["g"]), "a wider lobe has a lower peak"
+    assert after["drawn"] == after["g"] or all(
+        close(a, b) or (a + b) > 0 for a, b in zip(after["drawn"], after["g"])
+    )
+
+    # The light moves: slice and hemisphere map are recomputed for the new angle.
+    move(d, "#theta-i", 60)
+    settle(d)
+    check_slice_against_eval(d, 0, 60.0)
+    hemi = d.execute_script(
+        "const f = window.explorer.data.hemisphere; return {n: f.n, text: f.material, theta: f.theta_i,"
+        " g: Array.from(f.data.value_g)};")
+    n = hemi["n"]
+    cells = [(r, c) for r, c in [(n // 2, n // 4), (n // 3, n // 2), (n // 2 + 7, n // 2 + 9)]]
+    rows = []
+    for r, c in cells:
+        x, y = -1 + (c + 0.5) * 2 / n, -1 + (r + 0.5) * 2 / n
+        z = math.sqrt(1 - x * x - y * y)
+        rows.append((hemi["theta"], 0.0, math.degrees(math.acos(z)), math.degrees(math.atan2(y, x))))
+    for (r, c), (_, g, _) in zip(cells, eval_rows(hemi["text"], rows)):
+        assert abs(hemi["g"][r * n + c] - g) <= 1e-6 * abs(g) + 1e-12, (r, c, hemi["g"][r * n + c], g)
+
+    # Albedo: estimates from the sampler, in [0, 1] within their error.
+    alb = d.execute_script(
+        "const m = window.explorer.materials[1]; const f = window.explorer.data.albedo[m.id];"
+        "return {r: Array.from(f.data.reflect), e: Array.from(f.data.reflect_err)};")
+    assert len(alb["r"]) == 19
+    assert all(0 < r < 1 + 3 * e for r, e in zip(alb["r"], alb["e"]))
+
+
+def test_a_bad_value_shows_the_grammars_error(server, driver):
+    d = driver
+    d.get(server)
+    settle(d)
+    move(d, 'input[data-material="0"][data-key="alpha"][data-role="input"]', "-1", "change")
+    settle(d)
+    shown = d.execute_script("return document.querySelector('.error[data-material=\"0\"]').textContent")
+    bad = '{type = "conductor", distribution = "ggx", alpha = -1, material = "Au"}'
+    cli = subprocess.run([str(BIN), "eval", "--material", bad], input="", capture_output=True, text=True)
+    assert cli.returncode != 0
+    grammar = cli.stderr.strip().split("--material: ", 1)[1]
+    assert grammar in shown, (grammar, shown)
+    # The other material still shows its curves.
+    assert d.execute_script("return window.explorer.materials[1].error") is None
+
+
+def test_a_bad_starting_material_is_an_error_before_serving():
+    out = subprocess.run([str(BIN), "explore", "--port", "0", "--material", '{type = "conductor", alphaa = 1}'],
+                         capture_output=True, text=True, timeout=30)
+    assert out.returncode != 0
+    assert "unknown key `alphaa`" in out.stderr and "alpha_u" in out.stderr, out.stderr
+
+
+def test_screenshots_and_latency(server, driver):
+    d = driver
+    d.get(server)
+    settle(d)
+    ARTEFACTS.mkdir(parents=True, exist_ok=True)
+    d.save_screenshot(str(ARTEFACTS / "explorer.png"))
+    for view in ["slice", "polar", "hemisphere", "albedo"]:
+        d.find_element("id", f"{view}-plot").find_element("xpath", "..").screenshot(str(ARTEFACTS / f"explorer-{view}.png"))
+    # Latency of a slider move, from the input event to the view drawn (the page's own clock).
+    samples = {"slice": [], "hemisphere": []}
+    for k, theta in enumerate([10, 20, 35, 50, 65, 75, 15, 45]):
+        move(d, "#theta-i", theta)
+        settle(d)
+        lat = d.execute_script("return window.explorer.latency")
+        for v in samples:
+            samples[v].append(lat[v])
+    figures = {v: {"median_ms": sorted(s)[len(s) // 2], "max_ms": max(s)} for v, s in samples.items()}
+    (ARTEFACTS / "latency.json").write_text(json.dumps(figures, indent=2))
+    print("latency of a θ_i move (ms):", figures)
+    assert all(len(s) == 8 and all(x > 0 for x in s) for s in samples.values())
