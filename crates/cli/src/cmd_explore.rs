@@ -19,6 +19,9 @@ pub struct ExploreArgs {
     /// '{type = "conductor", distribution = "ggx", alpha = 0.2, material = "Au"}'.
     #[arg(long, value_name = "TOML")]
     material: Vec<String>,
+    /// A measured BRDF in the MERL binary format to open with (repeatable).
+    #[arg(long, value_name = "FILE")]
+    merl: Vec<std::path::PathBuf>,
 }
 
 pub fn run(a: ExploreArgs) -> Result<ExitCode> {
@@ -31,6 +34,7 @@ pub fn run(a: ExploreArgs) -> Result<ExitCode> {
         host: a.host,
         port: a.port,
         materials: a.material,
+        merl: a.merl,
     };
     serve(
         options,

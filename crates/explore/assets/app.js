@@ -36,7 +36,14 @@ function tomlValue(v) {
   return JSON.stringify(String(v));
 }
 
+// What a request names the material by: its TOML table, or `measured:ID`.
+function textOf(m) {
+  return m.kind === 'measured' ? m.text : tomlText(m);
+}
+app.textOf = textOf;
+
 function tomlText(m) {
+  if (m.kind === 'measured') return m.text;
   const keys = Object.keys(m.table);
   const order = app.types[m.type].keys;
   keys.sort((a, b) => order.indexOf(a) - order.indexOf(b));
@@ -111,6 +118,23 @@ function setKey(m, key, value) {
 }
 
 // ---- materials -----------------------------------------------------------------------------
+
+function newMeasured(v) {
+  return { kind: 'measured', id: app.nextId++, measuredId: v.id, type: 'measured', name: v.name, text: v.text, validBins: v.valid_bins, table: {}, color: Plots.PALETTE[(app.nextId - 2) % Plots.PALETTE.length], error: null, describe: '', stochastic: false };
+}
+
+app.addMeasured = v => {
+  app.materials.push(newMeasured(v));
+  app.active = app.materials.length - 1;
+  changed(app.materials[app.active]);
+};
+
+app.addMaterialFromText = async text => {
+  const x = await materialFromText(text);
+  app.materials.push(newMaterial(x.type, x.table));
+  app.active = app.materials.length - 1;
+  changed(app.materials[app.active]);
+};
 
 function newMaterial(type, table) {
   const m = { id: app.nextId++, type, table: table || {}, color: Plots.PALETTE[(app.nextId - 2) % Plots.PALETTE.length], error: null, describe: '', stochastic: false };
@@ -188,16 +212,17 @@ function renderMaterials() {
   const box = document.getElementById('materials');
   box.replaceChildren();
   app.materials.forEach((m, index) => {
+    if (m.kind === 'measured') { box.append(measuredCard(m, index)); return; }
     const ty = app.types[m.type];
     const card = el('div', { class: 'material' + (index === app.active ? ' active' : ''), style: '--color:' + m.color, dataset: { material: String(index) },
-      onclick: () => { if (app.active !== index) { app.active = index; renderMaterials(); schedule(['hemisphere']); } } });
+      onclick: () => { if (app.active !== index) { app.active = index; renderMaterials(); schedule(['hemisphere']); if (window.Panels) Panels.materialsChanged(); } } });
     const typeSelect = el('select', { dataset: { material: String(index), role: 'type' }, onchange: e => {
       const t = app.types[e.target.value];
       Object.assign(m, newMaterial(t.name, {}), { id: m.id, color: m.color });
       materialFromText(t.example).then(x => { m.table = x.table; retainApplicable(m); fillRequired(m); changed(m); });
     } }, ...app.schema.types.map(t => el('option', { value: t.name, selected: t.name === m.type }, t.name)));
     card.append(el('div', { class: 'top' }, typeSelect,
-      app.materials.length > 1 ? el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); app.materials.splice(index, 1); app.active = Math.min(app.active, app.materials.length - 1); renderMaterials(); schedule(); } }, '×') : null));
+      app.materials.length > 1 ? el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); app.materials.splice(index, 1); app.active = Math.min(app.active, app.materials.length - 1); renderMaterials(); schedule(); if (window.Panels) Panels.materialsChanged(); } }, '×') : null));
     card.append(el('div', { class: 'summary' }, ty.summary));
     const seen = new Set();
     for (const key of ty.keys) {
@@ -216,6 +241,17 @@ function renderMaterials() {
     box.append(card);
   });
   document.getElementById('hemi-material').textContent = 'material ' + (app.active + 1);
+}
+
+function measuredCard(m, index) {
+  const card = el('div', { class: 'material' + (index === app.active ? ' active' : ''), style: '--color:' + m.color, dataset: { material: String(index) },
+    onclick: () => { if (app.active !== index) { app.active = index; renderMaterials(); schedule(['hemisphere']); if (window.Panels) Panels.materialsChanged(); } } });
+  card.append(el('div', { class: 'top' }, el('strong', {}, 'measured: ' + m.name),
+    el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); app.materials.splice(index, 1); app.active = Math.max(0, Math.min(app.active, app.materials.length - 1)); renderMaterials(); schedule(); if (window.Panels) Panels.materialsChanged(); } }, '×')));
+  card.append(el('div', { class: 'summary' }, `MERL file, ${m.validBins} valid bins; nearest-bin values, sampled cosine-weighted (fit it in the Fit panel)`));
+  card.append(el('div', { class: 'error', dataset: { material: String(index), role: 'error' } }, m.error || ''));
+  card.append(el('div', { class: 'describe' }, m.describe || ''));
+  return card;
 }
 
 async function applyText(m, text) {
@@ -252,9 +288,11 @@ function changed(m) {
     m.signature = signature(m);
   }
   schedule();
+  if (window.Panels) Panels.materialsChanged();
 }
 
 function signature(m) {
+  if (m.kind === 'measured') return 'measured ' + m.text;
   return m.type + '|' + app.types[m.type].keys.map(k => { const p = applying(m, k); return p ? k + (k in m.table ? '+' : '-') + p.kind : ''; }).join(',');
 }
 
@@ -267,12 +305,14 @@ function schedule(views) {
   app.timer = setTimeout(() => { app.timer = null; const v = app.scheduled; app.scheduled = new Set(); update(v); }, 12);
 }
 
-async function post(view, slot, body) {
+// POSTs a view's request and decodes its frame, aborting the previous request of the same
+// view and slot. Background requests (the preview's passes) do not hold `settled()`.
+async function post(view, slot, body, background) {
   const id = view + ':' + slot;
   if (app.inflight[id]) app.inflight[id].abort();
   const ctl = new AbortController();
   app.inflight[id] = ctl;
-  app.pending++;
+  if (!background) app.pending++;
   try {
     const r = await fetch('/api/' + view, { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(body), signal: ctl.signal });
     if (!r.ok) {
@@ -281,10 +321,11 @@ async function post(view, slot, body) {
     }
     return decodeFrame(await r.arrayBuffer());
   } finally {
-    app.pending--;
+    if (!background) app.pending--;
     if (app.inflight[id] === ctl) delete app.inflight[id];
   }
 }
+app.post = post;
 
 function decodeFrame(buf) {
   const n = new DataView(buf).getUint32(0, true);
@@ -302,7 +343,7 @@ function baseRequest() {
 
 function update(views) {
   const t0 = app.changedAt || performance.now();
-  const texts = app.materials.map(tomlText);
+  const texts = app.materials.map(textOf);
   const jobs = [];
   if (views.has('slice')) {
     const live = new Set(app.materials.map(m => m.id));
@@ -314,8 +355,8 @@ function update(views) {
   }
   if (views.has('hemisphere') && app.materials[app.active]) {
     const m = app.materials[app.active];
-    jobs.push(post('hemisphere', 'active', { ...baseRequest(), material: tomlText(m), theta_i: app.view.thetaI, phi_i: app.view.phiI, n: app.view.hemiN })
-      .then(f => { app.data.hemisphere = f; drawHemisphere(); app.latency.hemisphere = performance.now() - t0; })
+    jobs.push(post('hemisphere', 'active', { ...baseRequest(), material: textOf(m), theta_i: app.view.thetaI, phi_i: app.view.phiI, n: app.view.hemiN })
+      .then(f => { app.data.hemisphere = f; drawHemisphere(); app.latency.hemisphere = performance.now() - t0; if (window.Panels) Panels.hemisphereDrawn(); })
       .catch(e => failed(m, e)));
   }
   if (views.has('albedo')) {
@@ -447,11 +488,8 @@ function bindViewControls() {
   bind('samples', 'samples', v => Math.max(1, Math.min(1048576, Math.round(Number(v)) || 1)), ['slice', 'hemisphere']);
   document.getElementById('scale').addEventListener('change', e => { app.view.scale = e.target.value; drawSlice(); drawHemisphere(); });
   document.getElementById('add-material').addEventListener('click', async () => {
-    const last = app.materials[app.materials.length - 1];
-    const x = await materialFromText(last ? tomlText(last) : app.schema.types[0].example);
-    app.materials.push(newMaterial(x.type, x.table));
-    app.active = app.materials.length - 1;
-    changed(app.materials[app.active]);
+    const last = [...app.materials].reverse().find(m => m.kind !== 'measured');
+    await app.addMaterialFromText(last ? tomlText(last) : app.schema.types[0].example);
   });
   window.addEventListener('resize', () => { drawSlice(); drawPolar(); drawHemisphere(); drawAlbedo(); });
 }
@@ -463,16 +501,18 @@ async function start() {
     t.params.forEach(p => { if (!keys.includes(p.key)) keys.push(p.key); });
     app.types[t.name] = Object.assign({}, t, { keys });
   }
-  const initial = (await (await fetch('/api/initial')).json()).materials;
-  const texts = initial;
-  for (const text of texts) {
+  const initial = await (await fetch('/api/initial')).json();
+  for (const text of initial.materials) {
     const x = await materialFromText(text);
     app.materials.push(newMaterial(x.type, x.table));
   }
+  for (const v of initial.measured) app.materials.push(newMeasured(v));
   bindViewControls();
+  if (window.Panels) Panels.bind();
   renderMaterials();
   app.materials.forEach(m => { m.signature = signature(m); });
   schedule();
+  if (window.Panels) Panels.materialsChanged();
 }
 
 start().catch(e => { document.getElementById('status').textContent = 'error: ' + e.message; app.errors.push(e.message); });

@@ -88,6 +88,14 @@ const Plots = (() => {
         for (let k = s.x.length - 1; k >= 0; k--) ctx.lineTo(X(s.x[k]), Y(Math.max(s.lo[k], opts.log ? 1e-300 : -Infinity)));
         ctx.fill();
       }
+      if (s.points) {
+        ctx.fillStyle = s.color;
+        s.x.forEach((x, k) => {
+          const y = s.y[k];
+          if (Number.isFinite(y) && (!opts.log || y > 0)) { ctx.beginPath(); ctx.arc(X(x), Y(y), 1.8, 0, 2 * Math.PI); ctx.fill(); }
+        });
+        continue;
+      }
       ctx.strokeStyle = s.color; ctx.lineWidth = 1.6; ctx.setLineDash(s.dash ? [5, 4] : []);
       ctx.beginPath(); let pen = false;
       s.x.forEach((x, k) => {
@@ -176,7 +184,7 @@ const Plots = (() => {
     for (let k = 0; k < bh; k++) { const [R, G, B] = colour(1 - k / bh); ctx.fillStyle = `rgb(${R},${G},${B})`; ctx.fillRect(bx, by + k, 14, 1); }
     ctx.fillStyle = '#444'; ctx.textAlign = 'left';
     ctx.fillText(fmt(hi), bx + 18, by + 8); ctx.fillText(fmt(lo), bx + 18, by + bh);
-    ctx.fillText(opts.label || '', bx - 4, by + bh + 0 > h - 2 ? h - 2 : by + bh / 2);
+    ctx.fillText(opts.label || '', bx + 18, by + bh / 2);
   }
 
   return { PALETTE, lineChart, polarChart, heatmap, fmt };

@@ -15,6 +15,16 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/app.js"),
     ),
     (
+        "/panels.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/panels.js"),
+    ),
+    (
+        "/lobe3d.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/lobe3d.js"),
+    ),
+    (
         "/plots.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/plots.js"),

@@ -14,6 +14,11 @@ impl Cancel {
         self.0.load(Ordering::Relaxed)
     }
 
+    /// The flag itself, for code that polls an `AtomicBool` (the renderer).
+    pub fn flag(&self) -> &AtomicBool {
+        &self.0
+    }
+
     pub fn cancel(&self) {
         self.0.store(true, Ordering::Relaxed);
     }

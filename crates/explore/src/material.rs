@@ -1,12 +1,15 @@
 //! A material as the app sends it — a TOML inline table, the syntax of `--material` and of
 //! scene files — parsed and built by the grammar ([`facette_bsdf::recipe`]), so the app
-//! shows the grammar's own error messages. Built materials are kept in a small cache keyed
-//! by their canonical text: moving the light does not rebuild a Kelemen albedo table or a
-//! glint map.
+//! shows the grammar's own error messages; or `measured:ID`, a MERL file the app uploaded
+//! (or `--merl` loaded), shown through [`MeasuredBsdf`]. Built materials are kept in a
+//! small cache keyed by their canonical text: moving the light does not rebuild a Kelemen
+//! albedo table or a glint map.
 
 use facette_bsdf::recipe::schema::material_type;
 use facette_bsdf::recipe::{build_material_with_reader, parse_inline_table};
 use facette_bsdf::Bsdf;
+use facette_lab::measured_bsdf::MeasuredBsdf;
+use facette_lab::merl::MerlBrdf;
 use facette_render::image::ImageNormalMapReader;
 use std::sync::{Arc, Mutex};
 
@@ -57,17 +60,79 @@ pub fn build(text: &str) -> Result<Material, String> {
     })
 }
 
-/// The last few materials built, by canonical text.
+/// How the app names a measured file as a material: `measured:ID`.
+pub const MEASURED_PREFIX: &str = "measured:";
+
+/// A measured file held in memory.
+#[derive(Clone)]
+pub struct MeasuredFile {
+    pub id: u64,
+    pub name: String,
+    pub merl: Arc<MerlBrdf>,
+    pub valid_bins: usize,
+}
+
+impl MeasuredFile {
+    /// Its material text, `measured:ID`.
+    pub fn text(&self) -> String {
+        format!("{MEASURED_PREFIX}{}", self.id)
+    }
+}
+
+/// The last few materials built, by canonical text, and the measured files loaded.
 #[derive(Default)]
 pub struct MaterialCache {
     entries: Mutex<Vec<Material>>,
+    measured: Mutex<(u64, Vec<MeasuredFile>)>,
 }
 
 impl MaterialCache {
     const SIZE: usize = 16;
+    /// Measured files kept (35 MB each); loading another drops the oldest.
+    pub const MEASURED_FILES: usize = 4;
+
+    /// Keeps a measured file; its id names it in later requests.
+    pub fn add_measured(&self, name: &str, merl: MerlBrdf) -> MeasuredFile {
+        let mut m = self.measured.lock().unwrap_or_else(|p| p.into_inner());
+        m.0 += 1;
+        let file = MeasuredFile {
+            id: m.0,
+            name: name.to_string(),
+            valid_bins: merl.valid_bins(),
+            merl: Arc::new(merl),
+        };
+        m.1.push(file.clone());
+        if m.1.len() > Self::MEASURED_FILES {
+            m.1.remove(0);
+        }
+        file
+    }
+
+    /// The measured file `id`.
+    pub fn measured(&self, id: u64) -> Result<MeasuredFile, String> {
+        let m = self.measured.lock().unwrap_or_else(|p| p.into_inner());
+        m.1.iter().find(|f| f.id == id).cloned().ok_or_else(|| {
+            format!(
+                "no measured file {id} (the server keeps the last {} loaded; load it again)",
+                Self::MEASURED_FILES
+            )
+        })
+    }
 
     /// The material of `text`, built once.
     pub fn get(&self, text: &str) -> Result<Material, String> {
+        if let Some(id) = text.trim().strip_prefix(MEASURED_PREFIX) {
+            let id: u64 = id
+                .trim()
+                .parse()
+                .map_err(|_| format!("`{text}`: expected {MEASURED_PREFIX}ID"))?;
+            let f = self.measured(id)?;
+            return Ok(Material {
+                text: f.text(),
+                table: toml::Table::new(),
+                bsdf: Arc::new(MeasuredBsdf::two_sided(f.merl.clone(), f.name.clone())),
+            });
+        }
         let key = parse_inline_table(text)
             .map(|t| canonical_text(&t))
             .map_err(|e| e.to_string())?;
@@ -116,5 +181,26 @@ mod tests {
             .get(r#"{ reflectance = 0.3, type = "lambert" }"#)
             .unwrap();
         assert!(Arc::ptr_eq(&a.bsdf, &b.bsdf));
+    }
+
+    #[test]
+    fn measured_files_are_materials_by_id() {
+        let cache = MaterialCache::default();
+        let f = cache.add_measured(
+            "grey.binary",
+            MerlBrdf::from_fn(|_, _, _| Some(facette_bsdf::Spectrum::splat(0.1))),
+        );
+        let m = cache.get(&f.text()).unwrap();
+        assert!(m.bsdf.describe().contains("grey.binary"));
+        assert!(cache
+            .get("measured:99")
+            .err()
+            .unwrap()
+            .contains("no measured file 99"));
+        assert!(cache
+            .get("measured:x")
+            .err()
+            .unwrap()
+            .contains("expected measured:ID"));
     }
 }

@@ -7,18 +7,23 @@
 
 use crate::assets::asset;
 use crate::cancel::Cancel;
+use crate::fitting::FitRequest;
 use crate::frame::Frame;
 use crate::material::{Material, MaterialCache};
+use crate::patch_ndf::PatchNdfRequest;
+use crate::preview::{PreviewRequest, PreviewScenes};
 use crate::schema_json::schema_json;
+use crate::validation::ValidateRequest;
 use crate::views::{self, AlbedoRequest, HemisphereRequest, SliceRequest};
 use anyhow::{Context, Result};
 use axum::body::Body;
-use axum::extract::{ConnectInfo, Request, State};
-use axum::http::{header, StatusCode, Uri};
+use axum::extract::{ConnectInfo, DefaultBodyLimit, Request, State};
+use axum::http::{header, HeaderMap, StatusCode, Uri};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
+use facette_lab::merl::MerlBrdf;
 use serde::Deserialize;
 use serde_json::json;
 use std::net::SocketAddr;
@@ -34,10 +39,13 @@ pub struct ExploreOptions {
     pub port: u16,
     /// Materials the app opens with (TOML inline tables).
     pub materials: Vec<String>,
+    /// Measured BRDFs (MERL binary files) the app opens with.
+    pub merl: Vec<std::path::PathBuf>,
 }
 
 struct AppState {
     cache: MaterialCache,
+    previews: PreviewScenes,
     initial: Vec<String>,
 }
 
@@ -69,6 +77,15 @@ pub fn serve(
             crate::material::build(m).map_err(|e| anyhow::anyhow!("--material `{m}`: {e}"))?;
         initial.push(built.text);
     }
+    let cache = MaterialCache::default();
+    for path in &options.merl {
+        let merl = MerlBrdf::load(path).map_err(|e| anyhow::anyhow!("--merl: {e}"))?;
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        initial.push(cache.add_measured(&name, merl).text());
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -87,7 +104,8 @@ pub fn serve(
         let addr = listener.local_addr()?;
         on_ready(addr);
         let state = Arc::new(AppState {
-            cache: MaterialCache::default(),
+            cache,
+            previews: PreviewScenes::default(),
             initial,
         });
         let app = router(state, options.host.is_none());
@@ -114,6 +132,14 @@ fn router(state: Shared, local_only: bool) -> Router {
         .route("/api/slice", post(slice))
         .route("/api/hemisphere", post(hemisphere))
         .route("/api/albedo", post(albedo))
+        .route("/api/validate", post(validate))
+        .route("/api/preview", post(preview))
+        .route("/api/patch-ndf", post(patch_ndf))
+        .route("/api/fit", post(fit))
+        .route(
+            "/api/measured",
+            post(measured).layer(DefaultBodyLimit::max(MEASURED_BODY_LIMIT)),
+        )
         .fallback(get(static_asset))
         .with_state(state);
     if local_only {
@@ -166,9 +192,24 @@ async fn static_asset(uri: Uri) -> Response {
     }
 }
 
+/// Materials and measured files the app opens with: `{"materials": [text…], "measured":
+/// [{id, name, text, valid_bins}…]}` (a measured file's text is `measured:ID`).
 async fn initial(State(s): State<Shared>) -> Json<serde_json::Value> {
-    Json(json!({ "materials": s.initial }))
+    let (materials, measured): (Vec<&String>, Vec<&String>) = s
+        .initial
+        .iter()
+        .partition(|t| !t.starts_with(crate::material::MEASURED_PREFIX));
+    let measured: Vec<_> = measured
+        .iter()
+        .filter_map(|t| t[crate::material::MEASURED_PREFIX.len()..].parse().ok())
+        .filter_map(|id| s.cache.measured(id).ok())
+        .map(|f| json!({"id": f.id, "name": f.name, "text": f.text(), "valid_bins": f.valid_bins}))
+        .collect();
+    Json(json!({ "materials": materials, "measured": measured }))
 }
+
+/// The largest upload: a MERL file is 34,992,016 bytes.
+const MEASURED_BODY_LIMIT: usize = 40 << 20;
 
 fn error(status: StatusCode, message: impl Into<String>) -> Response {
     (status, Json(json!({ "error": message.into() }))).into_response()
@@ -179,28 +220,80 @@ struct MaterialRequest {
     material: String,
 }
 
-/// Parses and builds a material: its canonical text and what it is, or the grammar's error.
-async fn material(State(s): State<Shared>, Json(q): Json<MaterialRequest>) -> Response {
-    let built = tokio::task::spawn_blocking(move || s.cache.get(&q.material)).await;
-    match built {
-        Ok(Ok(m)) => Json(json!({
-            "text": m.text,
-            "table": m.table,
-            "describe": m.bsdf.describe(),
-            "stochastic": m.bsdf.is_stochastic(),
-        }))
-        .into_response(),
+/// Runs `work` on a blocking thread with a flag raised if the request is dropped, and
+/// answers its value with `respond`; `None` (cancelled) is a 503, an error a 422 with its
+/// message, a panic a 500 (the server goes on).
+async fn blocking<T: Send + 'static>(
+    work: impl FnOnce(&Cancel) -> Result<Option<T>, String> + Send + 'static,
+    respond: impl FnOnce(T) -> Response,
+) -> Response {
+    let cancel = Cancel::default();
+    let guard = cancel.guard();
+    let done = tokio::task::spawn_blocking(move || work(&cancel)).await;
+    guard.disarm();
+    match done {
+        Ok(Ok(Some(v))) => respond(v),
+        Ok(Ok(None)) => error(StatusCode::SERVICE_UNAVAILABLE, "cancelled"),
         Ok(Err(e)) => error(StatusCode::UNPROCESSABLE_ENTITY, e),
         Err(e) => error(
             StatusCode::INTERNAL_SERVER_ERROR,
-            format!("internal error: {e}"),
+            format!("internal error while evaluating: {e}"),
         ),
     }
 }
 
-/// Runs a view on a blocking thread: builds the material (422 with the grammar's error),
-/// computes (cancelled if the request is dropped), and answers the encoded frame with the
-/// computation's time in `compute_ms`.
+fn frame_response(frame: Frame) -> Response {
+    Response::builder()
+        .header(header::CONTENT_TYPE, "application/octet-stream")
+        .body(Body::from(frame.encode()))
+        .unwrap_or_else(|e| error(StatusCode::INTERNAL_SERVER_ERROR, e.to_string()))
+}
+
+/// Loads an uploaded MERL file (the body; its name in `x-file-name`) into memory; nothing
+/// is written to disk. A corrupt file is a 422 with the reader's message.
+async fn measured(
+    State(s): State<Shared>,
+    headers: HeaderMap,
+    body: axum::body::Bytes,
+) -> Response {
+    let name = headers
+        .get("x-file-name")
+        .and_then(|h| h.to_str().ok())
+        .unwrap_or("upload")
+        .to_string();
+    blocking(
+        move |_| {
+            let merl = MerlBrdf::from_bytes(&body, &name).map_err(|e| e.to_string())?;
+            Ok(Some(s.cache.add_measured(&name, merl)))
+        },
+        |f| {
+            Json(json!({"id": f.id, "name": f.name, "text": f.text(), "valid_bins": f.valid_bins}))
+                .into_response()
+        },
+    )
+    .await
+}
+
+/// Parses and builds a material: its canonical text, its table and what it is, or the
+/// grammar's error.
+async fn material(State(s): State<Shared>, Json(q): Json<MaterialRequest>) -> Response {
+    blocking(
+        move |_| s.cache.get(&q.material).map(Some),
+        |m| {
+            Json(json!({
+                "text": m.text,
+                "table": m.table,
+                "describe": m.bsdf.describe(),
+                "stochastic": m.bsdf.is_stochastic(),
+            }))
+            .into_response()
+        },
+    )
+    .await
+}
+
+/// A view of one material: checked, built (the grammar's error otherwise), computed, and
+/// answered as a frame with the computation's time in `compute_ms`.
 async fn run_view(
     s: Shared,
     text: String,
@@ -210,29 +303,18 @@ async fn run_view(
     if let Err(e) = check {
         return error(StatusCode::BAD_REQUEST, e);
     }
-    let cancel = Cancel::default();
-    let guard = cancel.guard();
-    let done = tokio::task::spawn_blocking(move || {
-        let m = s.cache.get(&text)?;
-        let start = Instant::now();
-        Ok::<_, String>(
-            view(&m, &cancel).map(|f| f.field("compute_ms", start.elapsed().as_secs_f64() * 1e3)),
-        )
-    })
-    .await;
-    guard.disarm();
-    match done {
-        Ok(Ok(Some(frame))) => Response::builder()
-            .header(header::CONTENT_TYPE, "application/octet-stream")
-            .body(Body::from(frame.encode()))
-            .unwrap_or_else(|e| error(StatusCode::INTERNAL_SERVER_ERROR, e.to_string())),
-        Ok(Ok(None)) => error(StatusCode::SERVICE_UNAVAILABLE, "cancelled"),
-        Ok(Err(e)) => error(StatusCode::UNPROCESSABLE_ENTITY, e),
-        Err(e) => error(
-            StatusCode::INTERNAL_SERVER_ERROR,
-            format!("internal error while evaluating: {e}"),
-        ),
-    }
+    blocking(
+        move |cancel| {
+            let m = s.cache.get(&text)?;
+            let start = Instant::now();
+            Ok(
+                view(&m, cancel)
+                    .map(|f| f.field("compute_ms", start.elapsed().as_secs_f64() * 1e3)),
+            )
+        },
+        frame_response,
+    )
+    .await
 }
 
 async fn slice(State(s): State<Shared>, Json(q): Json<SliceRequest>) -> Response {
@@ -253,6 +335,56 @@ async fn albedo(State(s): State<Shared>, Json(q): Json<AlbedoRequest>) -> Respon
     run_view(s, q.material.clone(), q.check(), move |m, c| {
         views::albedo(&*m.bsdf, &m.text, &q, c)
     })
+    .await
+}
+
+async fn validate(State(s): State<Shared>, Json(q): Json<ValidateRequest>) -> Response {
+    if let Err(e) = q.check() {
+        return error(StatusCode::BAD_REQUEST, e);
+    }
+    blocking(
+        move |c| {
+            let m = s.cache.get(&q.material)?;
+            Ok(crate::validation::validate(&*m.bsdf, &q, c))
+        },
+        |v| Json(v).into_response(),
+    )
+    .await
+}
+
+async fn preview(State(s): State<Shared>, Json(q): Json<PreviewRequest>) -> Response {
+    if let Err(e) = q.check() {
+        return error(StatusCode::BAD_REQUEST, e);
+    }
+    blocking(
+        move |c| {
+            let scene = s.previews.get(&q.material, q.width, q.height)?;
+            crate::preview::render_pass(&scene, &q, c)
+        },
+        frame_response,
+    )
+    .await
+}
+
+async fn patch_ndf(Json(q): Json<PatchNdfRequest>) -> Response {
+    if let Err(e) = q.check() {
+        return error(StatusCode::BAD_REQUEST, e);
+    }
+    blocking(
+        move |_| crate::patch_ndf::patch_ndf(&q).map(Some),
+        frame_response,
+    )
+    .await
+}
+
+async fn fit(State(s): State<Shared>, Json(q): Json<FitRequest>) -> Response {
+    blocking(
+        move |_| {
+            let f = s.cache.measured(q.measured)?;
+            crate::fitting::fit(&f.merl, &q).map(|frame| Some(frame.field("measured_name", f.name)))
+        },
+        frame_response,
+    )
     .await
 }
 

@@ -9,5 +9,6 @@ pub mod fit;
 pub mod il_approx_fit;
 pub mod least_squares;
 pub mod measure;
+pub mod measured_bsdf;
 pub mod merl;
 pub mod plot;
