@@ -203,7 +203,6 @@ function paramRow(m, p, index) {
       onchange: e => { const v = p.kind === 'path' ? e.target.value : parseLoose(e.target.value); commit(v); } });
     text = el('span', { class: 'value' });
   }
-  if (!set && optional) { widget.addEventListener('focus', () => {}); }
   row.append(el('div', { class: 'widget' }, widget), text);
   return row;
 }

@@ -108,7 +108,12 @@ impl PreviewScenes {
         if let Some((_, s)) = self.lock().iter().find(|(k, _)| *k == key) {
             return Ok(s.clone());
         }
-        let source = scene_source(material, width, height);
+        // The material goes into the scene's text only as the grammar writes a parsed
+        // inline table back: a string that closes the table and adds lights or files to
+        // the scene (an environment `file` would be written) is refused here.
+        let table =
+            facette_bsdf::recipe::parse_inline_table(material).map_err(|e| e.to_string())?;
+        let source = scene_source(&crate::material::canonical_text(&table), width, height);
         let scene = load_scene_str(&source, std::path::Path::new("./preview.toml"))
             .map_err(|e| e.to_string())?;
         let scene = Arc::new(scene);
@@ -181,6 +186,16 @@ mod tests {
             .err()
             .unwrap();
         assert!(e.contains("alpha"), "{e}");
+        let injected =
+            "{type = \"lambert\"}\n[[lights]]\ntype = \"environment\"\nfile = \"sky.exr\"";
+        assert!(scenes.get(injected, 8, 8).is_err());
+        let quoted =
+            r#"{type = "glint", generate = "bumpy", resolution = 16, normal_encoding = "x\"}"}"#;
+        assert!(scenes
+            .get(quoted, 8, 8)
+            .err()
+            .unwrap()
+            .contains("unknown normal encoding `x\"}`"));
         let bad = PreviewRequest { spp: 0, ..q };
         assert!(bad.check().unwrap_err().contains("spp"));
     }

@@ -30,7 +30,15 @@ pub fn parse_inline_table(text: &str) -> Result<toml::Table, ParamError> {
             e.message()
         ))
     })?;
-    match t.remove("value") {
+    let value = t.remove("value");
+    // Text after the table (`{…}\n[[lights]]…`) parses as more of the document: refuse it
+    // rather than drop it silently.
+    if let Some(extra) = t.keys().next() {
+        return Err(ParamError::Invalid(format!(
+            "not a TOML inline table ({{key = value, ...}}): text after the table defines `{extra}`"
+        )));
+    }
+    match value {
         Some(toml::Value::Table(tab)) => Ok(tab),
         Some(other) => Err(ParamError::Invalid(format!(
             "expected a TOML inline table {{key = value, ...}}, got a {}",
@@ -52,5 +60,9 @@ mod tests {
         assert!(e.contains("not a TOML inline table"), "{e}");
         let e = parse_inline_table("3").unwrap_err().to_string();
         assert!(e.contains("got a integer"), "{e}");
+        let e = parse_inline_table("{type = \"lambert\"}\n[[lights]]\ntype = \"point\"")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("text after the table defines `lights`"), "{e}");
     }
 }
