@@ -37,6 +37,8 @@ install_browser() {
 }
 install_browser >"$browser_log" 2>&1 &
 browser_install=$!
+# A failing step ends the script: the install in the background ends with it.
+trap 'kill "$browser_install" 2>/dev/null || true' EXIT
 
 cargo test --workspace --profile optimized-tests
 

@@ -88,9 +88,14 @@ function startValue(p) {
   return parseLoose(p.start);
 }
 
+// As recipe::schema's retain_applicable: keys that no longer apply, and choices the entry
+// that now applies does not offer, are dropped.
 function retainApplicable(m) {
   for (;;) {
-    const stale = Object.keys(m.table).filter(k => !applying(m, k));
+    const stale = Object.keys(m.table).filter(k => {
+      const p = applying(m, k);
+      return !p || (p.kind === 'choice' && typeof m.table[k] === 'string' && !p.values.includes(m.table[k]));
+    });
     if (!stale.length) return;
     stale.forEach(k => delete m.table[k]);
   }
@@ -144,11 +149,13 @@ function newMaterial(type, table) {
 }
 
 async function materialFromText(text) {
+  if (text.trim().startsWith('measured:')) throw new Error('a measured file is opened with “load MERL file…”');
   const r = await fetch('/api/material', { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify({ material: text }) });
   const body = await r.json();
   if (!r.ok) throw new Error(body.error);
   const table = Object.assign({}, body.table);
   const type = table.type; delete table.type;
+  if (!app.types[type]) throw new Error(`type "${type}" has no controls in this page`);
   return { type, table, describe: body.describe, stochastic: body.stochastic };
 }
 
@@ -218,10 +225,14 @@ function renderMaterials() {
     const typeSelect = el('select', { dataset: { material: String(index), role: 'type' }, onchange: e => {
       const t = app.types[e.target.value];
       Object.assign(m, newMaterial(t.name, {}), { id: m.id, color: m.color });
-      materialFromText(t.example).then(x => { m.table = x.table; retainApplicable(m); fillRequired(m); changed(m); });
+      // Another change of type may answer first: only the type still chosen takes its example.
+      materialFromText(t.example).then(x => {
+        if (m.type !== x.type || !app.materials.includes(m)) return;
+        m.table = x.table; retainApplicable(m); fillRequired(m); changed(m);
+      }).catch(err => { m.error = err.message; renderMaterials(); });
     } }, ...app.schema.types.map(t => el('option', { value: t.name, selected: t.name === m.type }, t.name)));
     card.append(el('div', { class: 'top' }, typeSelect,
-      app.materials.length > 1 ? el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); app.materials.splice(index, 1); app.active = Math.min(app.active, app.materials.length - 1); renderMaterials(); schedule(); if (window.Panels) Panels.materialsChanged(); } }, '×') : null));
+      app.materials.length > 1 ? el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); removeMaterial(index); } }, '×') : null));
     card.append(el('div', { class: 'summary' }, ty.summary));
     const seen = new Set();
     for (const key of ty.keys) {
@@ -242,11 +253,21 @@ function renderMaterials() {
   document.getElementById('hemi-material').textContent = 'material ' + (app.active + 1);
 }
 
+// Removes material `index`; the selected material stays selected (or the one after it).
+function removeMaterial(index) {
+  app.materials.splice(index, 1);
+  if (index < app.active) app.active--;
+  app.active = Math.max(0, Math.min(app.active, app.materials.length - 1));
+  renderMaterials();
+  schedule();
+  if (window.Panels) Panels.materialsChanged();
+}
+
 function measuredCard(m, index) {
   const card = el('div', { class: 'material' + (index === app.active ? ' active' : ''), style: '--color:' + m.color, dataset: { material: String(index) },
     onclick: () => { if (app.active !== index) { app.active = index; renderMaterials(); schedule(['hemisphere']); if (window.Panels) Panels.materialsChanged(); } } });
   card.append(el('div', { class: 'top' }, el('strong', {}, 'measured: ' + m.name),
-    el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); app.materials.splice(index, 1); app.active = Math.max(0, Math.min(app.active, app.materials.length - 1)); renderMaterials(); schedule(); if (window.Panels) Panels.materialsChanged(); } }, '×')));
+    el('button', { title: 'remove', dataset: { material: String(index), role: 'remove' }, onclick: e => { e.stopPropagation(); removeMaterial(index); } }, '×')));
   card.append(el('div', { class: 'summary' }, `MERL file, ${m.validBins} valid bins; nearest-bin values, sampled cosine-weighted (fit it in the Fit panel)`));
   card.append(el('div', { class: 'error', dataset: { material: String(index), role: 'error' } }, m.error || ''));
   card.append(el('div', { class: 'describe' }, m.describe || ''));
@@ -350,24 +371,34 @@ function update(views) {
     jobs.push(Promise.allSettled(app.materials.map((m, k) =>
       post('slice', m.id, { ...baseRequest(), material: texts[k], theta_i: app.view.thetaI, points: 361 })
         .then(f => { app.data.slice[m.id] = f; m.describe = f.describe; m.stochastic = f.stochastic; })
-        .catch(e => failed(m, e)))).then(() => { drawSlice(); drawPolar(); app.latency.slice = performance.now() - t0; }));
+        .catch(e => failed(m, e)))).then(() => { draw(drawSlice); draw(drawPolar); app.latency.slice = performance.now() - t0; }));
   }
   if (views.has('hemisphere') && app.materials[app.active]) {
     const m = app.materials[app.active];
     jobs.push(post('hemisphere', 'active', { ...baseRequest(), material: textOf(m), theta_i: app.view.thetaI, phi_i: app.view.phiI, n: app.view.hemiN })
-      .then(f => { app.data.hemisphere = f; drawHemisphere(); app.latency.hemisphere = performance.now() - t0; if (window.Panels) Panels.hemisphereDrawn(); })
-      .catch(e => failed(m, e)));
+      .then(f => {
+        app.data.hemisphere = f;
+        draw(drawHemisphere);
+        app.latency.hemisphere = performance.now() - t0;
+        if (window.Panels) draw(Panels.hemisphereDrawn);
+      }, e => failed(m, e)));
   }
   if (views.has('albedo')) {
     jobs.push(Promise.allSettled(app.materials.map((m, k) =>
       post('albedo', m.id, { material: texts[k], angles: ALBEDO_ANGLES, samples: app.view.albedoSamples, seed: 1 })
         .then(f => { app.data.albedo[m.id] = f; })
-        .catch(e => failed(m, e)))).then(() => { drawAlbedo(); app.latency.albedo = performance.now() - t0; }));
+        .catch(e => failed(m, e)))).then(() => { draw(drawAlbedo); app.latency.albedo = performance.now() - t0; }));
   }
   Promise.allSettled(jobs).then(() => {
     renderDescribe();
     status();
   });
+}
+
+// Runs a drawing function; an error in it is the page's (kept in app.errors), not the
+// material's.
+function draw(f) {
+  try { f(); } catch (e) { app.errors.push(String(e && e.stack || e)); }
 }
 
 function failed(m, e) {

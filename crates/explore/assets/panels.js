@@ -85,6 +85,7 @@ const Panels = (() => {
 
   function message(canvas, text) {
     const ctx = canvas.getContext('2d');
+    if (!ctx) { canvas.title = text; return; }  // a WebGL canvas has no 2D context
     canvas.width = canvas.clientWidth; canvas.height = canvas.clientHeight;
     ctx.clearRect(0, 0, canvas.width, canvas.height);
     ctx.fillStyle = '#b00020'; ctx.font = '12px system-ui, sans-serif';
@@ -116,11 +117,15 @@ const Panels = (() => {
   }
 
   // ---- patch NDF (glints) ----------------------------------------------------------------------
+  let patchNdfKey = null;
   async function updatePatchNdf() {
     const m = app.materials[app.active];
     const fig = document.getElementById('patch-ndf-figure');
-    if (!m || m.type !== 'glint') { fig.hidden = true; return; }
+    if (!m || m.type !== 'glint') { fig.hidden = true; patchNdfKey = null; return; }
     fig.hidden = false;
+    // Only a change of the selected glint material recomputes its map.
+    if (app.textOf(m) === patchNdfKey) return;
+    patchNdfKey = app.textOf(m);
     try {
       const f = await app.post('patch-ndf', 'active', { material: app.textOf(m), n: 128, supersample: 2 });
       app.data.patchNdf = f;
@@ -128,7 +133,7 @@ const Panels = (() => {
       document.getElementById('patch-ndf-info').textContent =
         `footprint σ = ${f.footprint_size.slice(0, 2).join(', ')} texels at uv ${f.footprint_center.join(', ')} · ∫D_P cos θh dωh = ${f.integral.toFixed(4)}`;
     } catch (e) {
-      if (e.name !== 'AbortError' && e.message !== 'cancelled') document.getElementById('patch-ndf-info').textContent = e.message;
+      if (e.name !== 'AbortError' && e.message !== 'cancelled') { document.getElementById('patch-ndf-info').textContent = e.message; patchNdfKey = null; }
     }
   }
 
@@ -204,7 +209,7 @@ const Panels = (() => {
     const info = document.getElementById('measured-info');
     info.textContent = 'loading ' + file.name + '…';
     try {
-      const r = await fetch('/api/measured', { method: 'POST', headers: { 'x-file-name': file.name }, body: await file.arrayBuffer() });
+      const r = await fetch('/api/measured', { method: 'POST', headers: { 'x-file-name': encodeURIComponent(file.name) }, body: await file.arrayBuffer() });
       const v = await r.json();
       if (!r.ok) throw new Error(v.error);
       app.addMeasured(v);

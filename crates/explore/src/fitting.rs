@@ -51,7 +51,28 @@ fn seed() -> u64 {
     1
 }
 
+/// Bounds of a fit request's sizes (a fit cannot be interrupted once it runs).
+pub const MAX_IL_SAMPLES: usize = 1 << 12;
+pub const MAX_SAMPLES: usize = 100_000;
+
 impl FitRequest {
+    /// Checks the sizes (the names and the other ranges are [`FitOptions::check`]'s).
+    pub fn check(&self) -> Result<(), String> {
+        if !(8..=MAX_IL_SAMPLES).contains(&self.il_samples) {
+            return Err(format!(
+                "`il_samples` = {} is out of range: expected 8 <= il_samples <= {MAX_IL_SAMPLES}",
+                self.il_samples
+            ));
+        }
+        if !(10..=MAX_SAMPLES).contains(&self.samples) {
+            return Err(format!(
+                "`samples` = {} is out of range: expected 10 <= samples <= {MAX_SAMPLES}",
+                self.samples
+            ));
+        }
+        self.options().check().map_err(|e| e.to_string())
+    }
+
     pub fn options(&self) -> FitOptions {
         FitOptions {
             model: self.model.clone(),

@@ -5,13 +5,13 @@
 //! small cache keyed by their canonical text: moving the light does not rebuild a Kelemen
 //! albedo table or a glint map.
 
-use facette_bsdf::recipe::schema::material_type;
+use facette_bsdf::recipe::schema::{canonical_type, material_type};
 use facette_bsdf::recipe::{build_material_with_reader, parse_inline_table};
 use facette_bsdf::Bsdf;
 use facette_lab::measured_bsdf::MeasuredBsdf;
 use facette_lab::merl::MerlBrdf;
 use facette_render::image::ImageNormalMapReader;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// A parsed and built material.
 #[derive(Clone)]
@@ -43,14 +43,54 @@ pub fn canonical_text(table: &toml::Table) -> String {
         parts.push(format!("type = {t}"));
     }
     for k in keys {
-        parts.push(format!("{k} = {}", table[k.as_str()]));
+        parts.push(format!("{} = {}", toml_key(k), table[k.as_str()]));
     }
     format!("{{{}}}", parts.join(", "))
 }
 
+/// A key as TOML writes it: bare when it can be, quoted otherwise (so that no key, however
+/// spelt, ends the table it is written in).
+fn toml_key(k: &str) -> String {
+    let bare = !k.is_empty()
+        && k.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-');
+    if bare {
+        return k.to_string();
+    }
+    // A basic string on one line (toml's own writer may choose a multi-line string, which
+    // is no key).
+    let mut out = String::from("\"");
+    for c in k.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// Parses `text` with the type's alias (`diffuse`, `interfaced-lambertian`) replaced by
+/// its name, the one the schema and the app know.
+fn parse(text: &str) -> Result<toml::Table, String> {
+    let mut table = parse_inline_table(text).map_err(|e| e.to_string())?;
+    let ty = table
+        .get("type")
+        .and_then(|t| t.as_str())
+        .map(str::to_string);
+    if let Some(name) = ty.as_deref().and_then(canonical_type) {
+        if Some(name) != ty.as_deref() {
+            table.insert("type".into(), toml::Value::String(name.into()));
+        }
+    }
+    Ok(table)
+}
+
 /// Parses and builds `text`; the error is the grammar's message.
 pub fn build(text: &str) -> Result<Material, String> {
-    let table = parse_inline_table(text).map_err(|e| e.to_string())?;
+    let table = parse(text)?;
     let bsdf = build_material_with_reader(&table, std::path::Path::new("."), &ImageNormalMapReader)
         .map_err(|e| e.to_string())?;
     Ok(Material {
@@ -79,15 +119,21 @@ impl MeasuredFile {
     }
 }
 
-/// The last few materials built, by canonical text, and the measured files loaded.
+/// A build, shared by every request that asks for the same material while it runs.
+type SharedBuild = Arc<OnceLock<Result<Material, String>>>;
+
+/// The last few materials built (or being built), by canonical text, and the measured files
+/// loaded.
 #[derive(Default)]
 pub struct MaterialCache {
-    entries: Mutex<Vec<Material>>,
+    entries: Mutex<Vec<(String, SharedBuild)>>,
     measured: Mutex<(u64, Vec<MeasuredFile>)>,
 }
 
 impl MaterialCache {
-    const SIZE: usize = 16;
+    /// Materials kept. A glint material holds its map's lobes and hierarchy (about 40
+    /// bytes a texel: 640 MiB at 4096²), so the cache stays small.
+    const SIZE: usize = 8;
     /// Measured files kept (35 MB each); loading another drops the oldest.
     pub const MEASURED_FILES: usize = 4;
 
@@ -133,21 +179,27 @@ impl MaterialCache {
                 bsdf: Arc::new(MeasuredBsdf::two_sided(f.merl.clone(), f.name.clone())),
             });
         }
-        let key = parse_inline_table(text)
-            .map(|t| canonical_text(&t))
-            .map_err(|e| e.to_string())?;
-        if let Some(m) = self.lock().iter().find(|m| m.text == key) {
-            return Ok(m.clone());
-        }
-        let m = build(text)?;
-        let mut entries = self.lock();
-        entries.retain(|e| e.text != m.text);
-        entries.insert(0, m.clone());
-        entries.truncate(Self::SIZE);
-        Ok(m)
+        let key = canonical_text(&parse(text)?);
+        // The slice, hemisphere and albedo requests of one change ask at once: the first
+        // builds, the others wait for its result.
+        let cell = {
+            let mut entries = self.lock();
+            match entries.iter().position(|(k, _)| *k == key) {
+                Some(i) => {
+                    let e = entries.remove(i);
+                    entries.insert(0, e);
+                }
+                None => {
+                    entries.insert(0, (key.clone(), SharedBuild::default()));
+                    entries.truncate(Self::SIZE);
+                }
+            }
+            entries[0].1.clone()
+        };
+        cell.get_or_init(|| build(&key)).clone()
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Material>> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<(String, SharedBuild)>> {
         // A panic while holding the lock leaves a list of whole entries: keep using it.
         self.entries.lock().unwrap_or_else(|p| p.into_inner())
     }
@@ -170,6 +222,14 @@ mod tests {
     }
 
     #[test]
+    fn keys_that_are_not_bare_are_quoted() {
+        let t = parse_inline_table(r#"{type = "lambert", "a}\n[x]\n#" = 1}"#).unwrap();
+        let text = canonical_text(&t);
+        assert_eq!(parse_inline_table(&text).unwrap(), t, "{text}");
+        assert!(build(&text).err().unwrap().contains("unknown key"));
+    }
+
+    #[test]
     fn errors_are_the_grammars_and_the_cache_builds_once() {
         let e = build(r#"{type = "conductor", alpha = -1}"#).err().unwrap();
         assert!(e.contains("`alpha` = -1 is out of range"), "{e}");
@@ -178,9 +238,13 @@ mod tests {
             .get(r#"{type = "lambert", reflectance = 0.3}"#)
             .unwrap();
         let b = cache
-            .get(r#"{ reflectance = 0.3, type = "lambert" }"#)
+            .get(r#"{ reflectance = 0.3, type = "diffuse" }"#)
             .unwrap();
-        assert!(Arc::ptr_eq(&a.bsdf, &b.bsdf));
+        assert!(
+            Arc::ptr_eq(&a.bsdf, &b.bsdf),
+            "an alias is the same material"
+        );
+        assert_eq!(b.text, r#"{type = "lambert", reflectance = 0.3}"#);
     }
 
     #[test]

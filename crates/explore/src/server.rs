@@ -47,6 +47,11 @@ struct AppState {
     cache: MaterialCache,
     previews: PreviewScenes,
     initial: Vec<String>,
+    /// One permit per core: a computation waits for one before it starts, so a request
+    /// the app abandons while it waits (a slider dragged on) never runs.
+    workers: tokio::sync::Semaphore,
+    /// Raised at shutdown: running computations stop at their next poll.
+    stopping: Cancel,
 }
 
 type Shared = Arc<AppState>;
@@ -78,6 +83,13 @@ pub fn serve(
         initial.push(built.text);
     }
     let cache = MaterialCache::default();
+    if options.merl.len() > MaterialCache::MEASURED_FILES {
+        anyhow::bail!(
+            "--merl: at most {} files (each is 35 MB in memory), got {}",
+            MaterialCache::MEASURED_FILES,
+            options.merl.len()
+        );
+    }
     for path in &options.merl {
         let merl = MerlBrdf::load(path).map_err(|e| anyhow::anyhow!("--merl: {e}"))?;
         let name = path.file_name().map_or_else(
@@ -91,7 +103,7 @@ pub fn serve(
         .enable_all()
         .build()
         .context("starting the server's runtime")?;
-    runtime.block_on(async move {
+    let done = runtime.block_on(async move {
         let host = options.host.clone().unwrap_or_else(|| "127.0.0.1".into());
         let listener = tokio::net::TcpListener::bind((host.as_str(), options.port))
             .await
@@ -103,25 +115,47 @@ pub fn serve(
             })?;
         let addr = listener.local_addr()?;
         on_ready(addr);
+        let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
         let state = Arc::new(AppState {
             cache,
             previews: PreviewScenes::default(),
             initial,
+            workers: tokio::sync::Semaphore::new(workers),
+            stopping: Cancel::default(),
         });
-        let app = router(state, options.host.is_none());
-        axum::serve(
-            listener,
-            app.into_make_service_with_connect_info::<SocketAddr>(),
-        )
-        .with_graceful_shutdown(async move {
+        // Bound to a loopback address (the default, or `--host localhost`), the server
+        // answers loopback requests naming a loopback host only.
+        let app = router(state.clone(), addr.ip().is_loopback());
+        let stop = Arc::new(tokio::sync::Notify::new());
+        let signal = stop.clone();
+        tokio::spawn(async move {
             tokio::select! {
                 _ = tokio::signal::ctrl_c() => {}
                 _ = shutdown => {}
             }
-        })
-        .await
-        .context("serving")
-    })
+            state.stopping.cancel();
+            signal.notify_waiters();
+        });
+        let graceful = stop.clone();
+        let serving = axum::serve(
+            listener,
+            app.into_make_service_with_connect_info::<SocketAddr>(),
+        )
+        .with_graceful_shutdown(async move { graceful.notified().await });
+        // Requests still running get two seconds after the signal, then the server stops.
+        tokio::select! {
+            r = serving => r.context("serving"),
+            _ = async {
+                stop.notified().await;
+                tokio::time::sleep(std::time::Duration::from_secs(2)).await;
+            } => Ok(()),
+        }
+    });
+    done?;
+    // Blocking work still running (a fit cannot be interrupted) is left to end with the
+    // process rather than waited for.
+    runtime.shutdown_timeout(std::time::Duration::from_millis(200));
+    Ok(())
 }
 
 fn router(state: Shared, local_only: bool) -> Router {
@@ -220,16 +254,28 @@ struct MaterialRequest {
     material: String,
 }
 
-/// Runs `work` on a blocking thread with a flag raised if the request is dropped, and
-/// answers its value with `respond`; `None` (cancelled) is a 503, an error a 422 with its
-/// message, a panic a 500 (the server goes on).
+/// Runs `work` on a blocking thread once one of the state's worker permits is free, with a
+/// flag raised if the request is dropped, and answers its value with `respond`; `None`
+/// (cancelled, or the server stopping) is a 503, an error a 422 with its message, a panic a
+/// 500 (the server goes on).
 async fn blocking<T: Send + 'static>(
+    s: &Shared,
     work: impl FnOnce(&Cancel) -> Result<Option<T>, String> + Send + 'static,
     respond: impl FnOnce(T) -> Response,
 ) -> Response {
+    let Ok(_permit) = s.workers.acquire().await else {
+        return error(StatusCode::SERVICE_UNAVAILABLE, "the server is stopping");
+    };
     let cancel = Cancel::default();
     let guard = cancel.guard();
-    let done = tokio::task::spawn_blocking(move || work(&cancel)).await;
+    let stopping = s.stopping.clone();
+    let done = tokio::task::spawn_blocking(move || {
+        if stopping.is_cancelled() || cancel.is_cancelled() {
+            return Ok(None);
+        }
+        work(&cancel)
+    })
+    .await;
     guard.disarm();
     match done {
         Ok(Ok(Some(v))) => respond(v),
@@ -256,15 +302,28 @@ async fn measured(
     headers: HeaderMap,
     body: axum::body::Bytes,
 ) -> Response {
-    let name = headers
+    // The name is required: a page elsewhere cannot send this header without a preflight
+    // the server does not answer. The app percent-encodes it (headers are bytes).
+    let Some(name) = headers
         .get("x-file-name")
         .and_then(|h| h.to_str().ok())
-        .unwrap_or("upload")
-        .to_string();
+        .map(|h| {
+            percent_encoding::percent_decode_str(h)
+                .decode_utf8_lossy()
+                .into_owned()
+        })
+    else {
+        return error(
+            StatusCode::BAD_REQUEST,
+            "an upload names its file in `x-file-name`",
+        );
+    };
+    let state = s.clone();
     blocking(
+        &s,
         move |_| {
             let merl = MerlBrdf::from_bytes(&body, &name).map_err(|e| e.to_string())?;
-            Ok(Some(s.cache.add_measured(&name, merl)))
+            Ok(Some(state.cache.add_measured(&name, merl)))
         },
         |f| {
             Json(json!({"id": f.id, "name": f.name, "text": f.text(), "valid_bins": f.valid_bins}))
@@ -277,8 +336,10 @@ async fn measured(
 /// Parses and builds a material: its canonical text, its table and what it is, or the
 /// grammar's error.
 async fn material(State(s): State<Shared>, Json(q): Json<MaterialRequest>) -> Response {
+    let state = s.clone();
     blocking(
-        move |_| s.cache.get(&q.material).map(Some),
+        &s,
+        move |_| state.cache.get(&q.material).map(Some),
         |m| {
             Json(json!({
                 "text": m.text,
@@ -303,9 +364,11 @@ async fn run_view(
     if let Err(e) = check {
         return error(StatusCode::BAD_REQUEST, e);
     }
+    let state = s.clone();
     blocking(
+        &s,
         move |cancel| {
-            let m = s.cache.get(&text)?;
+            let m = state.cache.get(&text)?;
             let start = Instant::now();
             Ok(
                 view(&m, cancel)
@@ -342,9 +405,11 @@ async fn validate(State(s): State<Shared>, Json(q): Json<ValidateRequest>) -> Re
     if let Err(e) = q.check() {
         return error(StatusCode::BAD_REQUEST, e);
     }
+    let state = s.clone();
     blocking(
+        &s,
         move |c| {
-            let m = s.cache.get(&q.material)?;
+            let m = state.cache.get(&q.material)?;
             Ok(crate::validation::validate(&*m.bsdf, &q, c))
         },
         |v| Json(v).into_response(),
@@ -356,9 +421,14 @@ async fn preview(State(s): State<Shared>, Json(q): Json<PreviewRequest>) -> Resp
     if let Err(e) = q.check() {
         return error(StatusCode::BAD_REQUEST, e);
     }
+    let state = s.clone();
     blocking(
+        &s,
         move |c| {
-            let scene = s.previews.get(&q.material, q.width, q.height)?;
+            // The material passes the grammar (and its cache) before the scene is built:
+            // the scene loader takes more than a material (image textures, files).
+            let m = state.cache.get(&q.material)?;
+            let scene = state.previews.get(&m.text, q.width, q.height)?;
             crate::preview::render_pass(&scene, &q, c)
         },
         frame_response,
@@ -366,11 +436,12 @@ async fn preview(State(s): State<Shared>, Json(q): Json<PreviewRequest>) -> Resp
     .await
 }
 
-async fn patch_ndf(Json(q): Json<PatchNdfRequest>) -> Response {
+async fn patch_ndf(State(s): State<Shared>, Json(q): Json<PatchNdfRequest>) -> Response {
     if let Err(e) = q.check() {
         return error(StatusCode::BAD_REQUEST, e);
     }
     blocking(
+        &s,
         move |_| crate::patch_ndf::patch_ndf(&q).map(Some),
         frame_response,
     )
@@ -378,9 +449,14 @@ async fn patch_ndf(Json(q): Json<PatchNdfRequest>) -> Response {
 }
 
 async fn fit(State(s): State<Shared>, Json(q): Json<FitRequest>) -> Response {
+    if let Err(e) = q.check() {
+        return error(StatusCode::BAD_REQUEST, e);
+    }
+    let state = s.clone();
     blocking(
+        &s,
         move |_| {
-            let f = s.cache.measured(q.measured)?;
+            let f = state.cache.measured(q.measured)?;
             crate::fitting::fit(&f.merl, &q).map(|frame| Some(frame.field("measured_name", f.name)))
         },
         frame_response,

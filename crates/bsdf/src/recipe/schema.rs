@@ -276,12 +276,21 @@ impl MaterialType {
     }
 
     /// Removes the keys that do not apply to `table` (an `alpha` left over after
-    /// `distribution` became `gaussian`), until none is left; `type` stays.
+    /// `distribution` became `gaussian`) and the choices whose value the entry that now
+    /// applies does not offer (`g1 = "exact"` after Beckmann became Phong), until none is
+    /// left; `type` stays.
     pub fn retain_applicable(&self, table: &mut toml::Table) {
         loop {
             let stale: Vec<String> = table
                 .keys()
-                .filter(|k| k.as_str() != "type" && !self.key_applies(table, k))
+                .filter(|k| {
+                    let entry = self.applying(k, |q| self.value_of(table, q));
+                    let offered = match (entry.map(|e| e.kind), table[k.as_str()].as_str()) {
+                        (Some(ParamKind::Choice { values }), Some(v)) => values.contains(&v),
+                        _ => true,
+                    };
+                    k.as_str() != "type" && (entry.is_none() || !offered)
+                })
                 .cloned()
                 .collect();
             if stale.is_empty() {
@@ -642,7 +651,8 @@ const ENERGY_KEYS: &[Param] = &[
         &["uncompensated", "compensated"],
         "\"uncompensated\"",
         "Kulla & Conty's compensation lobe for the energy single scattering loses",
-    ),
+    )
+    .when(&[SINGLE]),
     choice(
         "height_distribution",
         crate::models::multiple_scattering::smith_microsurface::HeightDistribution::NAMES,
@@ -735,7 +745,7 @@ const DIELECTRIC: &[Param] = &[
     )
     .without_default("\"ground\"")
     .when(&[BECKMANN_GGX])
-    .excluding(&["alpha", "alpha_u", "alpha_v", "exponent", "ior"]),
+    .excluding(&["alpha", "alpha_u", "alpha_v", "exponent", "ior", "g1"]),
     SPECULAR_REFLECTANCE,
     reflectance(
         "specular_transmittance",
@@ -1081,6 +1091,20 @@ pub fn material_type(name: &str) -> Option<&'static MaterialType> {
     MATERIAL_SCHEMA.iter().find(|t| t.name == name)
 }
 
+/// Other names the grammar takes for a type: (alias, type).
+pub const TYPE_ALIASES: &[(&str, &str)] =
+    &[("diffuse", "lambert"), ("interfaced-lambertian", "il")];
+
+/// The type a `type` value names (itself, or the type of an alias); `None` if unknown.
+pub fn canonical_type(name: &str) -> Option<&'static str> {
+    material_type(name).map(|t| t.name).or_else(|| {
+        TYPE_ALIASES
+            .iter()
+            .find(|(a, _)| *a == name)
+            .map(|(_, t)| *t)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1147,6 +1171,16 @@ mod tests {
             }
             None => s,
         }
+    }
+
+    /// Whether `message` names `key` as a word (not merely contains its letters: every
+    /// message contains a `k`).
+    fn names(message: &str, key: &str) -> bool {
+        let word = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
+        message.match_indices(key).any(|(i, _)| {
+            !word(message[..i].chars().next_back())
+                && !word(message[i + key.len()..].chars().next())
+        })
     }
 
     fn with(t: &toml::Table, key: &str, v: toml::Value) -> toml::Table {
@@ -1336,7 +1370,7 @@ mod tests {
                     let e = parse(&ctx)
                         .err()
                         .unwrap_or_else(|| panic!("{at} = {v} in {ctx}: accepted"));
-                    assert!(e.to_string().contains(p.key), "{at} = {v}: {e}");
+                    assert!(names(&e.to_string(), p.key), "{at} = {v}: {e}");
                     probes += 1;
                 }
             }
@@ -1427,9 +1461,44 @@ mod tests {
                 let e = parse(&ctx)
                     .err()
                     .unwrap_or_else(|| panic!("{at}: {ctx} accepted"));
-                assert!(e.to_string().contains(p.key), "{at}: {e}");
+                assert!(names(&e.to_string(), p.key), "{at}: {e}");
             }
         }
+    }
+
+    #[test]
+    fn aliases_name_the_same_types() {
+        for (alias, name) in TYPE_ALIASES {
+            assert_eq!(canonical_type(alias), Some(*name));
+            let ty = material_type(name).unwrap();
+            let t = example(ty);
+            let aliased = with(&t, "type", toml::Value::String(alias.to_string()));
+            assert_eq!(
+                fingerprint(&parse(&t).unwrap()),
+                fingerprint(&parse(&aliased).unwrap())
+            );
+        }
+        assert_eq!(canonical_type("plastic"), None);
+    }
+
+    #[test]
+    fn a_choice_the_new_entry_does_not_offer_is_dropped() {
+        let ty = material_type("conductor").unwrap();
+        let mut t = parse_inline_table(
+            r#"{type = "conductor", distribution = "phong", alpha = 0.2, g1 = "exact", masking = "smith"}"#,
+        )
+        .unwrap();
+        ty.retain_applicable(&mut t);
+        assert!(!t.contains_key("g1"), "{t}");
+        assert!(t.contains_key("masking"));
+        t.insert(
+            "distribution".into(),
+            toml::Value::String("gaussian".into()),
+        );
+        ty.retain_applicable(&mut t);
+        ty.fill_required(&mut t);
+        assert!(!t.contains_key("masking") && t.contains_key("sigma"), "{t}");
+        parse(&t).unwrap();
     }
 
     #[test]
@@ -1451,9 +1520,9 @@ mod tests {
                 // A section shared by several types names them in its heading.
                 let common = docs.split("\n### ").any(|sec| {
                     let heading = sec.lines().next().unwrap_or("");
-                    heading.contains(&format!("{})", ty.name))
-                        || heading.contains(&format!("({},", ty.name))
-                            && sec.contains(&format!("`{k}`"))
+                    (heading.contains(&format!("{})", ty.name))
+                        || heading.contains(&format!("({},", ty.name)))
+                        && sec.contains(&format!("`{k}`"))
                 });
                 assert!(
                     shared || common || section.contains(&format!("`{k}`")),

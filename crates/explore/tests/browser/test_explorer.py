@@ -10,6 +10,7 @@ import json
 import math
 import os
 import re
+import select
 import subprocess
 import time
 from pathlib import Path
@@ -35,7 +36,8 @@ def server():
         stderr=subprocess.PIPE,
         text=True,
     )
-    line = proc.stdout.readline()
+    ready, _, _ = select.select([proc.stdout], [], [], 60)
+    line = proc.stdout.readline() if ready else ""
     m = re.search(r"http://\S+/", line)
     assert m, f"no URL in {line!r}; stderr: {proc.stderr.read() if proc.poll() is not None else ''}"
     yield m.group(0)
@@ -89,6 +91,7 @@ def slice_of(d, k):
     return d.execute_script(
         "const m = window.explorer.materials[arguments[0]]; const f = window.explorer.data.slice[m.id];"
         "return {text: f.material, theta: Array.from(f.data.theta_o), g: Array.from(f.data.reflect_g),"
+        " r: Array.from(f.data.reflect_r), b: Array.from(f.data.reflect_b),"
         " drawn: window.explorer.drawn.slice.filter(s => s.material === m.id && s.side === 'reflect')[0].y};", k)
 
 
@@ -124,9 +127,9 @@ def test_the_views_show_what_eval_computes_and_follow_the_controls(server, drive
     after = check_slice_against_eval(d, 0, 30.0)
     assert "alpha = 0.4" in after["text"], after["text"]
     assert max(after["g"]) < 0.5 * max(before["g"]), "a wider lobe has a lower peak"
-    assert after["drawn"] == after["g"] or all(
-        close(a, b) or (a + b) > 0 for a, b in zip(after["drawn"], after["g"])
-    )
+    # The curve drawn is the channel mean of the numbers received.
+    mean = [(r + g + b) / 3 for r, g, b in zip(after["r"], after["g"], after["b"])]
+    assert len(after["drawn"]) == len(mean) and all(close(a, b) for a, b in zip(after["drawn"], mean))
 
     # The light moves: slice and hemisphere map are recomputed for the new angle.
     move(d, "#theta-i", 60)
@@ -282,7 +285,12 @@ def test_a_measured_file_is_shown_and_fitted(server, driver, tmp_path):
     s = d.execute_script(
         "const m = window.explorer.materials.find(m => m.kind === 'measured'); const f = window.explorer.data.slice[m.id];"
         "return {theta: Array.from(f.data.theta_o), g: Array.from(f.data.reflect_g)};")
-    assert max(s["g"]) > 0
+    # Nearest-bin values against the source model at the same directions: the bins are
+    # 1° (θ_h near the peak) to 2° wide, so a smooth lobe agrees within a few percent.
+    picks = [i for i, t in enumerate(s["theta"]) if abs(t) < 60][::20]
+    ref = eval_rows(source, plane_rows(30.0, [s["theta"][i] for i in picks]))
+    for i, (_, g, _) in zip(picks, ref):
+        assert abs(s["g"][i] - g) <= 0.1 * g, (s["theta"][i], s["g"][i], g)
     # Fit the IL model (closed-form body) and check the parameters come back.
     assert d.execute_script("return document.getElementById('fit-figure').hidden") is False
     d.execute_script("document.getElementById('fit-model').value = 'il'; document.getElementById('fit-model').dispatchEvent(new Event('change'));"
