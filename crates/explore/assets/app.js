@@ -117,6 +117,8 @@ function setKey(m, key, value) {
   else {
     m.table[key] = value;
     if (p) p.excludes.forEach(k => delete m.table[k]);
+    // Exclusion goes both ways: giving `alpha` removes a `preset` that excludes it.
+    app.types[m.type].params.forEach(q => { if (q.excludes.includes(key) && q.key in m.table && q.key !== key) delete m.table[q.key]; });
   }
   retainApplicable(m);
   fillRequired(m);

@@ -27,7 +27,8 @@ pub fn check_lobe(masking: Masking, sampling: NormalSampling) -> ParamResult<()>
     if sampling != NormalSampling::Visible {
         return Err(ParamError::Invalid(
             "scattering = \"multiple\" samples by the random walk, which draws visible normals \
-             (HHdD16): `sampling` does not apply"
+             (HHdD16): `sampling` does not apply, and the distribution needs a visible-normal \
+             sampler (beckmann, ggx; phong has none)"
                 .into(),
         ));
     }
