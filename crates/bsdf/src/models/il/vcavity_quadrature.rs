@@ -187,6 +187,8 @@ struct Hit {
     fres: f64,
     /// Cosine between the arriving direction and the facet normal.
     cos: f64,
+    /// Fresnel reflectance of the facet at that cosine (computed once per footprint).
+    f: f64,
     /// Specular bounces before this footprint.
     bounces: usize,
     /// Facet of the first footprint.
@@ -239,6 +241,7 @@ fn trace_beam(w: &Wedge, d: (f64, f64), ni: f64, hits: &mut Vec<Hit>, exits: &mu
                 power: 0.5 * (xb - xa),
                 fres: 1.0,
                 cos,
+                f: fresnel_dielectric(cos, ni),
                 bounces: 0,
                 first: k,
                 d,
@@ -249,7 +252,7 @@ fn trace_beam(w: &Wedge, d: (f64, f64), ni: f64, hits: &mut Vec<Hit>, exits: &mu
     while idx < hits.len() {
         let h = hits[idx];
         idx += 1;
-        let f = fresnel_dielectric(h.cos, ni);
+        let f = h.f;
         let power = h.power * f;
         if !(power > 1e-16) || h.bounces >= MAX_BOUNCES {
             continue;
@@ -292,6 +295,7 @@ fn trace_beam(w: &Wedge, d: (f64, f64), ni: f64, hits: &mut Vec<Hit>, exits: &mu
                 power: power * frac,
                 fres,
                 cos: cos2,
+                f: fresnel_dielectric(cos2, ni),
                 bounces: h.bounces + 1,
                 first: h.first,
                 d: d2,
@@ -810,9 +814,9 @@ impl VCavityQuadrature {
         op
     }
 
-    /// Traces the beams from i and o into groove `w` at azimuth φ (into `scratch`).
-    fn trace_both(&self, w: &Wedge, i: Vec3, o: Vec3, phi: f64, scratch: &mut Scratch) {
-        let (sp, cp) = phi.sin_cos();
+    /// Traces the beams from i and o into groove `w` at the azimuth φ whose sine and cosine
+    /// are given (into `scratch`).
+    fn trace_both(&self, w: &Wedge, i: Vec3, o: Vec3, (sp, cp): (f64, f64), scratch: &mut Scratch) {
         let di = (-(i.x * cp + i.y * sp), -i.z);
         let dout = (-(o.x * cp + o.y * sp), -o.z);
         trace_beam(w, di, self.ni, &mut scratch.ih, &mut scratch.ie);
@@ -831,7 +835,7 @@ impl VCavityQuadrature {
             if !(wa > 0.0) {
                 continue;
             }
-            let jd = a.power / wa * (1.0 - fresnel_dielectric(a.cos, self.ni));
+            let jd = a.power / wa * (1.0 - a.f);
             for b in &scratch.oh {
                 if b.facet != a.facet {
                     continue;
@@ -846,7 +850,7 @@ impl VCavityQuadrature {
                 }
                 let ov = a.u1.min(b.u1) - a.u0.max(b.u0);
                 if ov > 0.0 {
-                    let e = (1.0 - fresnel_dielectric(b.cos, self.ni)) * b.cos * b.fres / PI;
+                    let e = (1.0 - b.f) * b.cos * b.fres / PI;
                     direct += ov * jd * e;
                 }
             }
@@ -872,7 +876,7 @@ impl VCavityQuadrature {
             if (second && a.bounces > 0) || !(a.u1 > a.u0) {
                 continue;
             }
-            let jd = a.power / (a.u1 - a.u0) * (1.0 - fresnel_dielectric(a.cos, self.ni));
+            let jd = a.power / (a.u1 - a.u0) * (1.0 - a.f);
             let (x0, x1) = ends(a);
             scratch.src.push((a.facet, jd, x0, x1));
         }
@@ -881,7 +885,7 @@ impl VCavityQuadrature {
             if (second && b.bounces > 0) || !(b.u1 > b.u0) {
                 continue;
             }
-            let ev = (1.0 - fresnel_dielectric(b.cos, self.ni)) * b.cos * b.fres / PI;
+            let ev = (1.0 - b.f) * b.cos * b.fres / PI;
             let (x0, x1) = ends(b);
             scratch.dst.push((b.facet, ev, x0, x1));
         }
@@ -927,7 +931,7 @@ impl VCavityQuadrature {
                 op
             }
         };
-        self.trace_both(&op.wedge, i, o, phi, &mut state.scratch);
+        self.trace_both(&op.wedge, i, o, phi.sin_cos(), &mut state.scratch);
         let mut out = [0.0; CHANNELS];
         self.galerkin_density(&op, &mut state.scratch, &mut out);
         state.memo.insert(key, out);
@@ -988,13 +992,21 @@ impl VCavityQuadrature {
         };
         let mut scratch = Scratch::default();
         let dirac = self.specular_chains(i, o, &mut scratch);
+        // The inner rule runs over φ at one θ: its wedge is made once.
+        let mut wedge = (f64::NAN, Wedge::new(0.0));
         let mut direct_at = |theta: f64, phi: f64| {
-            let w = weight(theta, phi);
-            if !(w > 0.0) {
+            if theta.to_bits() != wedge.0.to_bits() {
+                wedge = (theta, Wedge::new(theta));
+            }
+            let w = &wedge.1;
+            let (sp, cp) = phi.sin_cos();
+            let m = Vec3::new(w.s * cp, w.s * sp, w.c);
+            let weight = 2.0 * self.ndf.d(m) * w.c * w.s;
+            if !(weight > 0.0) {
                 return 0.0;
             }
-            self.trace_both(&Wedge::new(theta), i, o, phi, &mut scratch);
-            w * self.direct_density(&scratch)
+            self.trace_both(w, i, o, (sp, cp), &mut scratch);
+            weight * self.direct_density(&scratch)
         };
         // The inter-reflections, all channels at once, remembered per node: the pilot's
         // nodes are the first nodes of the final pass.
