@@ -5,9 +5,10 @@
 
 use crate::merl::MerlBrdf;
 use facette_bsdf::math::rng::RandomSource;
-use facette_bsdf::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
+use facette_bsdf::math::cosine_lobe::sample_cosine_same_side;
+use facette_bsdf::math::warp::cosine_hemisphere_pdf;
 use facette_bsdf::two_sided::{OpaqueBsdf, TwoSided};
-use facette_bsdf::{BsdfContext, BsdfSample, LobeFlags, Spectrum, Vec2, Vec3};
+use facette_bsdf::{BsdfContext, BsdfSample, LobeFlags, Spectrum, Vec3};
 use std::sync::Arc;
 
 /// A MERL file's values as an opaque BRDF of the upper hemisphere.
@@ -45,12 +46,7 @@ impl OpaqueBsdf for MeasuredBsdf {
         if wo.z <= 0.0 {
             return None;
         }
-        let u = rng.next_2d();
-        let wi = square_to_cosine_hemisphere(Vec2::new(u.x, u.y));
-        let pdf = cosine_hemisphere_pdf(wi);
-        if pdf <= 0.0 {
-            return None;
-        }
+        let (wi, pdf) = sample_cosine_same_side(wo, rng)?;
         let f = self.eval(wo, wi, ctx, rng);
         Some(BsdfSample {
             wi,

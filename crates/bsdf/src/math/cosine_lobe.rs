@@ -7,7 +7,7 @@ use super::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use super::{flip, Vec3};
 
 /// A cosine-distributed direction on the side of `wo`, with its solid-angle pdf.
-pub(crate) fn sample_cosine_same_side(wo: Vec3, rng: &mut dyn RandomSource) -> Option<(Vec3, f64)> {
+pub fn sample_cosine_same_side(wo: Vec3, rng: &mut dyn RandomSource) -> Option<(Vec3, f64)> {
     if wo.z == 0.0 {
         return None;
     }

@@ -9,7 +9,7 @@
 
 pub mod adaptive_quadrature;
 pub mod complex;
-pub(crate) mod cosine_lobe;
+pub mod cosine_lobe;
 pub mod quadrature;
 pub mod rng;
 pub mod sin_cos;
