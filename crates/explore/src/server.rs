@@ -254,26 +254,31 @@ struct MaterialRequest {
     material: String,
 }
 
-/// Runs `work` on a blocking thread once one of the state's worker permits is free, with a
-/// flag raised if the request is dropped, and answers its value with `respond`; `None`
-/// (cancelled, or the server stopping) is a 503, an error a 422 with its message, a panic a
-/// 500 (the server goes on).
+/// Answers a request whose fields passed `check` (a 400 with its message otherwise) by
+/// running `work` on a blocking thread, with the server's state, once one of the state's
+/// worker permits is free, with a flag raised if the request is dropped, and answers its
+/// value with `respond`; `None` (cancelled, or the server stopping) is a 503, an error a 422
+/// with its message, a panic a 500 (the server goes on).
 async fn blocking<T: Send + 'static>(
     s: &Shared,
-    work: impl FnOnce(&Cancel) -> Result<Option<T>, String> + Send + 'static,
+    check: Result<(), String>,
+    work: impl FnOnce(&Shared, &Cancel) -> Result<Option<T>, String> + Send + 'static,
     respond: impl FnOnce(T) -> Response,
 ) -> Response {
+    if let Err(e) = check {
+        return error(StatusCode::BAD_REQUEST, e);
+    }
     let Ok(_permit) = s.workers.acquire().await else {
         return error(StatusCode::SERVICE_UNAVAILABLE, "the server is stopping");
     };
     let cancel = Cancel::default();
     let guard = cancel.guard();
-    let stopping = s.stopping.clone();
+    let state = s.clone();
     let done = tokio::task::spawn_blocking(move || {
-        if stopping.is_cancelled() || cancel.is_cancelled() {
+        if state.stopping.is_cancelled() || cancel.is_cancelled() {
             return Ok(None);
         }
-        work(&cancel)
+        work(&state, &cancel)
     })
     .await;
     guard.disarm();
@@ -318,10 +323,10 @@ async fn measured(
             "an upload names its file in `x-file-name`",
         );
     };
-    let state = s.clone();
     blocking(
         &s,
-        move |_| {
+        Ok(()),
+        move |state, _| {
             let merl = MerlBrdf::from_bytes(&body, &name).map_err(|e| e.to_string())?;
             Ok(Some(state.cache.add_measured(&name, merl)))
         },
@@ -336,10 +341,10 @@ async fn measured(
 /// Parses and builds a material: its canonical text, its table and what it is, or the
 /// grammar's error.
 async fn material(State(s): State<Shared>, Json(q): Json<MaterialRequest>) -> Response {
-    let state = s.clone();
     blocking(
         &s,
-        move |_| state.cache.get(&q.material).map(Some),
+        Ok(()),
+        move |state, _| state.cache.get(&q.material).map(Some),
         |m| {
             Json(json!({
                 "text": m.text,
@@ -361,13 +366,10 @@ async fn run_view(
     check: Result<(), String>,
     view: impl FnOnce(&Material, &Cancel) -> Option<Frame> + Send + 'static,
 ) -> Response {
-    if let Err(e) = check {
-        return error(StatusCode::BAD_REQUEST, e);
-    }
-    let state = s.clone();
     blocking(
         &s,
-        move |cancel| {
+        check,
+        move |state, cancel| {
             let m = state.cache.get(&text)?;
             let start = Instant::now();
             Ok(
@@ -402,13 +404,10 @@ async fn albedo(State(s): State<Shared>, Json(q): Json<AlbedoRequest>) -> Respon
 }
 
 async fn validate(State(s): State<Shared>, Json(q): Json<ValidateRequest>) -> Response {
-    if let Err(e) = q.check() {
-        return error(StatusCode::BAD_REQUEST, e);
-    }
-    let state = s.clone();
     blocking(
         &s,
-        move |c| {
+        q.check(),
+        move |state, c| {
             let m = state.cache.get(&q.material)?;
             Ok(crate::validation::validate(&*m.bsdf, &q, c))
         },
@@ -418,13 +417,10 @@ async fn validate(State(s): State<Shared>, Json(q): Json<ValidateRequest>) -> Re
 }
 
 async fn preview(State(s): State<Shared>, Json(q): Json<PreviewRequest>) -> Response {
-    if let Err(e) = q.check() {
-        return error(StatusCode::BAD_REQUEST, e);
-    }
-    let state = s.clone();
     blocking(
         &s,
-        move |c| {
+        q.check(),
+        move |state, c| {
             // The material passes the grammar (and its cache) before the scene is built:
             // the scene loader takes more than a material (image textures, files).
             let m = state.cache.get(&q.material)?;
@@ -437,25 +433,20 @@ async fn preview(State(s): State<Shared>, Json(q): Json<PreviewRequest>) -> Resp
 }
 
 async fn patch_ndf(State(s): State<Shared>, Json(q): Json<PatchNdfRequest>) -> Response {
-    if let Err(e) = q.check() {
-        return error(StatusCode::BAD_REQUEST, e);
-    }
     blocking(
         &s,
-        move |_| crate::patch_ndf::patch_ndf(&q).map(Some),
+        q.check(),
+        move |_, _| crate::patch_ndf::patch_ndf(&q).map(Some),
         frame_response,
     )
     .await
 }
 
 async fn fit(State(s): State<Shared>, Json(q): Json<FitRequest>) -> Response {
-    if let Err(e) = q.check() {
-        return error(StatusCode::BAD_REQUEST, e);
-    }
-    let state = s.clone();
     blocking(
         &s,
-        move |_| {
+        q.check(),
+        move |state, _| {
             let f = state.cache.measured(q.measured)?;
             crate::fitting::fit(&f.merl, &q).map(|frame| Some(frame.field("measured_name", f.name)))
         },

@@ -4,8 +4,8 @@
 //! data carry no sampling density of their own). Two-sided through [`TwoSided`].
 
 use crate::merl::MerlBrdf;
-use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::cosine_lobe::sample_cosine_same_side;
+use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::cosine_hemisphere_pdf;
 use facette_bsdf::two_sided::{OpaqueBsdf, TwoSided};
 use facette_bsdf::{BsdfContext, BsdfSample, LobeFlags, Spectrum, Vec3};
