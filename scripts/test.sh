@@ -37,10 +37,15 @@ install_browser() {
 }
 install_browser >"$browser_log" 2>&1 &
 browser_install=$!
-# A failing step ends the script: the install in the background ends with it.
-trap 'kill "$browser_install" 2>/dev/null || true' EXIT
+# Each phase's wall time, printed at the end (what CI's total is made of). A failing step
+# ends the script: the browser install in the background ends with it.
+phases=()
+phase() { phases+=("$(printf '%5d s  %s' "$SECONDS" "$1")"); SECONDS=0; }
+trap 'kill "$browser_install" 2>/dev/null || true; [ ${#phases[@]} -eq 0 ] || printf "%s\n" "phase times:" "${phases[@]}"' EXIT
+SECONDS=0
 
 cargo test --workspace --profile optimized-tests
+phase "cargo test (build and run)"
 
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
 py="$venv/bin/python"
@@ -49,13 +54,16 @@ mkdir -p "$wheels"
 rm -f "$wheels"/facette-*.whl
 MATURIN_PEP517_ARGS="--profile optimized-tests" \
     "$py" -m pip wheel --quiet --no-deps ./crates/python -w "$wheels"
+phase "wheel"
 wheel=$(echo "$wheels"/facette-*.whl)
 # The version does not change between builds: --force-reinstall replaces the package
 # (and only it: --no-deps), then the extra's dependencies are installed when missing.
 "$py" -m pip install --quiet --force-reinstall --no-deps "$wheel"
 "$py" -m pip install --quiet "$wheel[test]"
+phase "environment"
 
 "$py" -m pytest -q crates/python/tests
+phase "Python tests"
 
 if ! wait "$browser_install"; then
     echo "error: installing chromium and chromium-driver failed (see $browser_log):" >&2
@@ -66,3 +74,4 @@ fi
 FACETTE_BIN="$CARGO_TARGET_DIR/optimized-tests/facette" \
     FACETTE_ARTEFACTS="$CARGO_TARGET_DIR/explore-artefacts" \
     "$py" -m pytest -q crates/explore/tests/browser
+phase "browser tests (with the browser's install wait)"
