@@ -5,7 +5,9 @@
 #   1. cargo test: every crate, optimized-tests profile (the statistical suites need
 #      optimized code; see the README).
 #   2. The Python package built as a wheel (maturin, fetched by pip) from the same target
-#      directory and profile, so the Rust crates compile once; into target/wheels/.
+#      directory and profile, with its `test-build` feature (the strict finite guard and the
+#      features the Rust tests unify on shared crates), so the Rust crates compile once;
+#      into target/wheels/.
 #   3. A virtual environment (target/test-venv, kept between runs) with that wheel and its
 #      `test` extra (pytest, Ray, matplotlib; numpy): the wheel installs as a user would
 #      install it, without Rust.
@@ -52,7 +54,7 @@ py="$venv/bin/python"
 wheels="$CARGO_TARGET_DIR/wheels"
 mkdir -p "$wheels"
 rm -f "$wheels"/facette-*.whl
-MATURIN_PEP517_ARGS="--profile optimized-tests" \
+MATURIN_PEP517_ARGS="--profile optimized-tests --features test-build" \
     "$py" -m pip wheel --quiet --no-deps ./crates/python -w "$wheels"
 phase "wheel"
 wheel=$(echo "$wheels"/facette-*.whl)
