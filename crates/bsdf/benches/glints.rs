@@ -1,9 +1,13 @@
-//! Benchmarks of the glint model [CCM19] on generated 2048² maps: the cost of one P-NDF
+//! Benchmarks of the glint model [CCM19] on generated maps (2048² unless told): the cost of one P-NDF
 //! query against the footprint size, the build of the lobe mixture (lobes, slope hierarchy
 //! and moment pyramid), and eval/sample of the P-BRDF with exact and approximate masking.
-//! Also prints the memory per texel of each part. Results are in docs/performance.md.
+//! Also prints the memory per texel of each part and the mip level each masking mode
+//! chooses per footprint size. Results are in docs/performance.md.
 //!
 //!   cargo bench -p facette-bsdf --bench glints -- --warm-up-time 1 --measurement-time 3
+//!
+//! `FACETTE_GLINT_BENCH_SIZE=4096` runs it on 4096² maps instead (issue 20: mip levels and
+//! cache behaviour at that size; about 1.4 GB for the two surfaces).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use facette_bsdf::fresnel::Fresnel;
@@ -13,7 +17,9 @@ use facette_bsdf::math::spherical_direction;
 use facette_bsdf::models::glint::footprint::FootprintQuery;
 use facette_bsdf::models::glint::hierarchy::SlopeHierarchy;
 use facette_bsdf::models::glint::microsurface::{build_lobes, DEFAULT_ROUGHNESS_FLOOR};
-use facette_bsdf::models::glint::patch_masking::DEFAULT_MASKING_LOBES;
+use facette_bsdf::models::glint::patch_masking::{
+    choose_level, APPROX_BLOCKS, DEFAULT_MASKING_LOBES,
+};
 use facette_bsdf::models::glint::patch_ndf::PatchNdf;
 use facette_bsdf::models::glint::{
     generate, Footprint, GlintBsdf, GlintParams, GlintSurface, MaskingMode, NormalMapKind,
@@ -22,26 +28,36 @@ use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, Vec2, Vec3};
 use std::sync::{Arc, OnceLock};
 
-const SIZE: usize = 2048;
+/// The maps' side in texels: 2048, or `FACETTE_GLINT_BENCH_SIZE`.
+fn size() -> usize {
+    static S: OnceLock<usize> = OnceLock::new();
+    *S.get_or_init(|| {
+        std::env::var("FACETTE_GLINT_BENCH_SIZE")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(2048)
+    })
+}
 const SIGMAS: [f64; 4] = [1.0, 4.0, 16.0, 64.0];
 const KINDS: [(&str, NormalMapKind); 2] = [
     ("scratched", NormalMapKind::Scratched),
     ("bumpy", NormalMapKind::Bumpy),
 ];
 
-/// The 2048² surfaces, built once for every benchmark.
+/// The surfaces, built once for every benchmark.
 fn surface(kind: usize) -> Arc<GlintSurface> {
     static S: OnceLock<Vec<Arc<GlintSurface>>> = OnceLock::new();
     S.get_or_init(|| {
         KINDS
             .iter()
             .map(|(name, k)| {
-                let map = generate(*k, SIZE, 3).unwrap();
+                let size = size();
+                let map = generate(*k, size, 3).unwrap();
                 let s =
-                    GlintSurface::build(map, DEFAULT_ROUGHNESS_FLOOR, format!("{name} {SIZE}²"))
+                    GlintSurface::build(map, DEFAULT_ROUGHNESS_FLOOR, format!("{name} {size}²"))
                         .unwrap();
                 println!(
-                    "{name} {SIZE}²: built in {:.2} s (lobes + hierarchy + mip levels)",
+                    "{name} {size}²: built in {:.2} s (lobes + hierarchy + mip levels)",
                     s.build_seconds()
                 );
                 for l in s.memory().lines() {
@@ -58,45 +74,68 @@ fn surface(kind: usize) -> Arc<GlintSurface> {
         .clone()
 }
 
-/// 64 footprint centres spread over the map (texels).
+/// 64 footprint centres spread over the map (texels): each query reads memory the one
+/// before did not.
 fn centres() -> Vec<Vec2> {
+    let size = size() as f64;
     (0..64)
         .map(|k| {
             let k = k as f64;
             Vec2::new(
-                (k * 0.618_034).fract() * SIZE as f64,
-                (k * 0.754_877).fract() * SIZE as f64,
+                (k * 0.618_034).fract() * size,
+                (k * 0.754_877).fract() * size,
             )
         })
         .collect()
 }
 
+/// 64 centres on an 8 × 8 grid `step` texels apart at the map's centre: neighbouring pixels'
+/// footprints, as a renderer's tile queries them (they share the lobes they read).
+fn clustered_centres(step: f64) -> Vec<Vec2> {
+    let mid = 0.5 * size() as f64;
+    (0..64)
+        .map(|k| Vec2::new(mid + step * (k % 8) as f64, mid + step * (k / 8) as f64))
+        .collect()
+}
+
 /// P-NDF queries: per footprint size, 256 slopes per batch, either half vectors drawn from
 /// the footprint's own P-NDF (a glint is found: the case that matters for shading) or
-/// uniform over θ_h < 40° (mostly empty space).
+/// uniform over θ_h < 40° (mostly empty space); footprints spread over the map, or (drawn
+/// half vectors) clustered as neighbouring pixels' (cache behaviour).
 fn pndf_query(c: &mut Criterion) {
     for (kind, (name, _)) in KINDS.iter().enumerate() {
         let surf = surface(kind);
-        let mut g = c.benchmark_group(format!("pndf-query-{name}-{SIZE}"));
+        let size = size();
+        let mut g = c.benchmark_group(format!("pndf-query-{name}-{size}"));
         g.throughput(Throughput::Elements(256));
         // σ = 64 visits ~10⁵ lobes per query: 10 samples keep the run to seconds.
         g.sample_size(10);
         for sigma in SIGMAS {
-            let queries: Vec<FootprintQuery> = centres()
-                .into_iter()
-                .map(|c| FootprintQuery::new(Footprint::isotropic(c, sigma), SIZE, SIZE))
-                .collect();
+            let query_at = |c| FootprintQuery::new(Footprint::isotropic(c, sigma), size, size);
+            let queries: Vec<FootprintQuery> = centres().into_iter().map(query_at).collect();
+            let clustered: Vec<FootprintQuery> =
+                clustered_centres(sigma).into_iter().map(query_at).collect();
+            let q0 = &queries[0];
+            println!(
+                "{name} {size}², σ = {sigma} texels: mip level of the approximate masking {}, of the exact masking's sum {}",
+                choose_level(&surf, q0, APPROX_BLOCKS),
+                choose_level(&surf, q0, DEFAULT_MASKING_LOBES as f64)
+            );
             let mut rng = Pcg32::new(7, 1);
             // (query index, slope) pairs.
-            let sampled: Vec<(usize, [f64; 2])> = (0..256)
-                .map(|k| {
-                    let q = k % queries.len();
-                    let m = PatchNdf::new(&surf, &queries[q])
-                        .sample_normal(&mut rng)
-                        .unwrap_or(Vec3::Z);
-                    (q, [-m.x / m.z, -m.y / m.z])
-                })
-                .collect();
+            let mut sample_slopes = |queries: &[FootprintQuery]| -> Vec<(usize, [f64; 2])> {
+                (0..256)
+                    .map(|k| {
+                        let q = k % queries.len();
+                        let m = PatchNdf::new(&surf, &queries[q])
+                            .sample_normal(&mut rng)
+                            .unwrap_or(Vec3::Z);
+                        (q, [-m.x / m.z, -m.y / m.z])
+                    })
+                    .collect()
+            };
+            let sampled = sample_slopes(&queries);
+            let sampled_clustered = sample_slopes(&clustered);
             let uniform: Vec<(usize, [f64; 2])> = (0..256)
                 .map(|k| {
                     let h = spherical_direction(
@@ -106,7 +145,12 @@ fn pndf_query(c: &mut Criterion) {
                     (k % queries.len(), [-h.x / h.z, -h.y / h.z])
                 })
                 .collect();
-            for (what, set) in [("sampled-h", &sampled), ("uniform-h", &uniform)] {
+            let runs = [
+                ("sampled-h", &sampled, &queries),
+                ("uniform-h", &uniform, &queries),
+                ("sampled-h-clustered", &sampled_clustered, &clustered),
+            ];
+            for (what, set, queries) in runs {
                 let (mut lobes, mut nonzero) = (0usize, 0usize);
                 for (q, s) in set.iter() {
                     let (v, n) = PatchNdf::new(&surf, &queries[*q]).p22_counting(*s);
@@ -132,11 +176,12 @@ fn pndf_query(c: &mut Criterion) {
     }
 }
 
-/// Building the mixture of a 2048² scratched map: lobes, then lobes + slope hierarchy, then
+/// Building the mixture of a scratched map: lobes, then lobes + slope hierarchy, then
 /// the whole surface (with the moment pyramid of the approximate masking).
 fn mixture_build(c: &mut Criterion) {
-    let map = generate(NormalMapKind::Scratched, SIZE, 3).unwrap();
-    let mut g = c.benchmark_group(format!("mixture-build-scratched-{SIZE}"));
+    let size = size();
+    let map = generate(NormalMapKind::Scratched, size, 3).unwrap();
+    let mut g = c.benchmark_group(format!("mixture-build-scratched-{size}"));
     g.sample_size(10);
     g.bench_function("lobes", |b| {
         b.iter(|| black_box(build_lobes(&map, DEFAULT_ROUGHNESS_FLOOR)))
@@ -144,7 +189,7 @@ fn mixture_build(c: &mut Criterion) {
     g.bench_function("lobes+hierarchy", |b| {
         b.iter(|| {
             let lobes = build_lobes(&map, DEFAULT_ROUGHNESS_FLOOR);
-            black_box(SlopeHierarchy::build(&lobes, SIZE, SIZE))
+            black_box(SlopeHierarchy::build(&lobes, size, size))
         })
     });
     g.bench_function("surface", |b| {
@@ -193,7 +238,7 @@ fn glint_bsdf(c: &mut Criterion) {
                 ))
             })
             .collect();
-        let mut g = c.benchmark_group(format!("glint-scratched-{SIZE}-sigma-4-{mode_name}"));
+        let mut g = c.benchmark_group(format!("glint-scratched-{}-sigma-4-{mode_name}", size()));
         g.throughput(Throughput::Elements(256));
         let ctx = BsdfContext::RADIANCE;
         g.bench_function("eval", |b| {
