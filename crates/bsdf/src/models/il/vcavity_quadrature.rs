@@ -985,11 +985,11 @@ impl VCavityQuadrature {
             hi: PI,
             breaks: azimuth_breaks(theta, i, o),
         };
-        let weight = |theta: f64, phi: f64| {
-            let (st, ct) = theta.sin_cos();
-            let m = Vec3::new(st * phi.cos(), st * phi.sin(), ct);
-            2.0 * self.ndf.d(m) * ct * st
+        // The groove weight 2 D(m) cos θ_m sin θ_m from the sines and cosines of θ_m and φ_m.
+        let weight_of = |(st, ct): (f64, f64), (sp, cp): (f64, f64)| {
+            2.0 * self.ndf.d(Vec3::new(st * cp, st * sp, ct)) * ct * st
         };
+        let weight = |theta: f64, phi: f64| weight_of(theta.sin_cos(), phi.sin_cos());
         let mut scratch = Scratch::default();
         let dirac = self.specular_chains(i, o, &mut scratch);
         // The inner rule runs over φ at one θ: its wedge is made once.
@@ -999,13 +999,12 @@ impl VCavityQuadrature {
                 wedge = (theta, Wedge::new(theta));
             }
             let w = &wedge.1;
-            let (sp, cp) = phi.sin_cos();
-            let m = Vec3::new(w.s * cp, w.s * sp, w.c);
-            let weight = 2.0 * self.ndf.d(m) * w.c * w.s;
+            let azimuth = phi.sin_cos();
+            let weight = weight_of((w.s, w.c), azimuth);
             if !(weight > 0.0) {
                 return 0.0;
             }
-            self.trace_both(w, i, o, (sp, cp), &mut scratch);
+            self.trace_both(w, i, o, azimuth, &mut scratch);
             weight * self.direct_density(&scratch)
         };
         // The inter-reflections, all channels at once, remembered per node: the pilot's
