@@ -1441,6 +1441,18 @@ mod tests {
     use crate::scene::load_scene_str;
     use facette_bsdf::lanes::F64x8;
 
+    /// The kernel as a function of its own for the tests. `render_tile_lanes` is
+    /// `#[inline(always)]` (the AVX2 build needs its body compiled inside
+    /// `render_tile_avx2`); inlined into these tests' loops over samplers, estimators and
+    /// pixels, LLVM spent 12 of the crate's 13 minutes of compile rotating their loops.
+    #[inline(never)]
+    fn render_tile_with<S: ShadingLanes, G: Real>(
+        job: &TileJob,
+        sums: &mut Vec<PixelSums>,
+    ) -> usize {
+        render_tile_lanes::<S, G>(job, sums)
+    }
+
     const SCENE: &str = r#"
         [camera]
         position = [0, 0.8, 4]
@@ -1552,9 +1564,9 @@ mod tests {
                 let sampler = PixelSampler::new(kind, 4, w, h, 8);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let mut lanes = Vec::new();
-                assert_eq!(render_tile_lanes::<F64x8, F64x8>(&job, &mut lanes), h);
+                assert_eq!(render_tile_with::<F64x8, F64x8>(&job, &mut lanes), h);
                 let mut f32_lanes = Vec::new();
-                render_tile_lanes::<F32x8, GeometryLanes>(&job, &mut f32_lanes);
+                render_tile_with::<F32x8, GeometryLanes>(&job, &mut f32_lanes);
                 let mut worst: f64 = 0.0;
                 for y in 0..h {
                     for x in 0..w {
@@ -1597,8 +1609,8 @@ mod tests {
                 let sampler = PixelSampler::new(kind, 9, w, h, 16);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let (mut f64_geometry, mut f32_geometry) = (Vec::new(), Vec::new());
-                render_tile_lanes::<F32x8, F64x8>(&job, &mut f64_geometry);
-                render_tile_lanes::<F32x8, F32x8>(&job, &mut f32_geometry);
+                render_tile_with::<F32x8, F64x8>(&job, &mut f64_geometry);
+                render_tile_with::<F32x8, F32x8>(&job, &mut f32_geometry);
                 let mean = |image: &[PixelSums]| -> [f64; 3] {
                     let mut m = [0.0; 3];
                     for p in image {
@@ -1658,7 +1670,7 @@ mod tests {
                 let sampler = PixelSampler::new(kind, 5, w, h, 8);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let (mut portable, mut avx2) = (Vec::new(), Vec::new());
-                render_tile_lanes::<F32x8, GeometryLanes>(&job, &mut portable);
+                render_tile_with::<F32x8, GeometryLanes>(&job, &mut portable);
                 // SAFETY: the CPU has AVX2 and FMA (tested above).
                 unsafe { render_tile_avx2(&job, &mut avx2) };
                 assert_eq!(portable.len(), w * h);
@@ -1698,10 +1710,7 @@ mod tests {
             stop: &stop,
         };
         let mut sums = Vec::new();
-        assert_eq!(
-            render_tile_lanes::<F32x8, GeometryLanes>(&job, &mut sums),
-            3
-        );
+        assert_eq!(render_tile_with::<F32x8, GeometryLanes>(&job, &mut sums), 3);
         assert_eq!(sums.len(), 3 * 8);
         assert!(sums.iter().all(|p| p.count() == 2));
     }
