@@ -359,9 +359,11 @@ pub(crate) struct TileJob<'a> {
     pub stop: &'a dyn Fn() -> bool,
 }
 
-/// Renders every sample of `job.chunk` for the tile's pixels into `sums` (row-major, one
-/// entry per pixel of the rows started), with the widest lanes this CPU runs; returns the
-/// number of rows started (a stop leaves the later rows out).
+/// Renders every sample of `job.chunk` for the tile's pixels and adds them to `sums`
+/// (row-major, one entry per pixel of the tile: made, zeroed, when `sums` does not have that
+/// length, and otherwise added to, so that a tile's sums gather all passes and reach the
+/// film once), with the widest lanes this CPU runs; returns the number of rows started (a
+/// stop leaves the later rows out: their entries get nothing from this call).
 pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     #[cfg(target_arch = "x86_64")]
     if facette_bsdf::lanes::avx2::available() {
@@ -398,8 +400,11 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
     sums: &mut Vec<PixelSums>,
 ) -> usize {
     debug_assert_eq!(S::LANES, LANES);
-    sums.clear();
-    sums.resize(job.xs.len() * job.ys.len(), PixelSums::default());
+    let pixels = job.xs.len() * job.ys.len();
+    if sums.len() != pixels {
+        sums.clear();
+        sums.resize(pixels, PixelSums::default());
+    }
     let mut jobs = Jobs::new(job);
     let mut batch = CameraBatch::<G> {
         count: 0,
@@ -446,7 +451,6 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         }
         k.step(&mut paths, &mut segment, sums);
     }
-    sums.truncate(jobs.rows_started * job.xs.len());
     jobs.rows_started
 }
 
@@ -1686,7 +1690,8 @@ mod tests {
         }
     }
 
-    /// A stop before a row leaves that row and the later ones out.
+    /// A stop before a row leaves that row and the later ones out; a second call adds to the
+    /// sums of the first.
     #[test]
     fn a_stop_ends_the_tile_at_a_row() {
         let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
@@ -1711,7 +1716,13 @@ mod tests {
         };
         let mut sums = Vec::new();
         assert_eq!(render_tile_with::<F32x8, GeometryLanes>(&job, &mut sums), 3);
-        assert_eq!(sums.len(), 3 * 8);
-        assert!(sums.iter().all(|p| p.count() == 2));
+        assert_eq!(sums.len(), 16 * 8);
+        let counts = |sums: &[PixelSums]| sums.iter().map(|p| p.count()).collect::<Vec<_>>();
+        let rows = |a: u32, b: u32| [vec![a; 3 * 8], vec![b; 13 * 8]].concat();
+        assert_eq!(counts(&sums), rows(2, 0));
+        // Three more rows before the next stop: the first three get their second pass.
+        asked.set(0);
+        assert_eq!(render_tile_with::<F32x8, GeometryLanes>(&job, &mut sums), 3);
+        assert_eq!(counts(&sums), rows(4, 0));
     }
 }
