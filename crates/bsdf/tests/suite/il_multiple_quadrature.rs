@@ -210,8 +210,10 @@ fn recipes_select_the_quadrature_for_eval() {
 #[test]
 fn coloured_substrates_are_three_grey_ones() {
     // Each channel has its own resolvent (c_b differs); the coloured evaluation must give,
-    // channel by channel, exactly the grey evaluation with that K_d (checked on the last
-    // channel, the others ordered by K_d).
+    // channel by channel, the grey evaluation with that K_d within their reported errors
+    // (checked on the last channel, the others ordered by K_d). Not bit for bit: the
+    // channels share the direct part, integrated to the smallest channel's budget, and the
+    // rule's choices follow the budget.
     let (wo, wi) = (spherical_direction(0.7, 0.0), spherical_direction(0.5, 2.2));
     let ndf = || Ndf::Beckmann(Beckmann::isotropic(0.6).unwrap());
     let lobe = || SpecularLobe::new(ndf(), Masking::VCavity, NormalSampling::Visible).unwrap();
@@ -234,10 +236,12 @@ fn coloured_substrates_are_three_grey_ones() {
         let grey = build(Spectrum::splat(k));
         let g = grey.multiple_quadrature().unwrap().eval(wi, wo);
         assert!(
-            (c.value[ch] - g.value[1]).abs() <= 1e-12 * g.value[1],
-            "channel {ch}: {} vs grey {}",
+            (c.value[ch] - g.value[1]).abs() <= c.error[ch] + g.error[1],
+            "channel {ch}: {} ± {:.1e} vs grey {} ± {:.1e}",
             c.value[ch],
-            g.value[1]
+            c.error[ch],
+            g.value[1],
+            g.error[1]
         );
         assert!(g.value[1] > 0.0);
     }

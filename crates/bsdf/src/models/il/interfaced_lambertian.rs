@@ -351,7 +351,15 @@ impl InterfacedLambertian {
                 h,
             ),
             BodyEvaluation::Adaptive { tolerance } => {
-                let q = integral.integrate(i, o, *tolerance, h);
+                // With the multiple scattering by quadrature too, the body takes half of the
+                // tolerance and the inter-reflections what its error leaves of the other
+                // half (`multiple_eval`), so that f₁ + f_ms meets the tolerance.
+                let share = if self.ms_quadrature.is_some() {
+                    0.5
+                } else {
+                    1.0
+                };
+                let q = integral.integrate(i, o, share * *tolerance, h);
                 (q.value, q.error)
             }
             BodyEvaluation::Table(t) => (t.lookup(i, o), 0.0),
@@ -376,11 +384,33 @@ impl InterfacedLambertian {
         (spec + k * b, k * se)
     }
 
-    /// The multiple-scattering part for `eval`: the quadrature when configured, else one walk.
-    fn multiple_eval(&self, o: Vec3, i: Vec3, rng: &mut dyn RandomSource) -> Spectrum {
+    /// The multiple-scattering part for `eval` of the BRDF value `single` + f_ms: the
+    /// quadrature when configured (to the tolerance relative to that value, `single`'s own
+    /// error estimate left out of the budget; see [`VCavityQuadrature::eval_in`]), else one
+    /// walk.
+    fn multiple_eval(
+        &self,
+        o: Vec3,
+        i: Vec3,
+        (single, single_error): (Spectrum, Spectrum),
+        rng: &mut dyn RandomSource,
+    ) -> Spectrum {
         match &self.ms_quadrature {
-            Some(q) => q.eval(i, o).value,
+            Some(q) => {
+                q.eval_in(i, o, single, self.deterministic_error(single_error))
+                    .value
+            }
             None => self.multiple(o, i, rng),
+        }
+    }
+
+    /// The single-scattering error that counts against a quadrature's budget: the adaptive
+    /// body quadrature's estimate; a stochastic body's standard error is noise of another
+    /// kind, outside the tolerance.
+    fn deterministic_error(&self, single_error: Spectrum) -> Spectrum {
+        match self.evaluation {
+            BodyEvaluation::Adaptive { .. } => single_error,
+            _ => Spectrum::ZERO,
         }
     }
 
@@ -435,7 +465,8 @@ impl OpaqueBsdf for InterfacedLambertian {
 
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
         let (o, i) = (wo, wi);
-        let v = self.single(o, i, 1, rng).0 + self.multiple_eval(o, i, rng);
+        let single = self.single(o, i, 1, rng);
+        let v = single.0 + self.multiple_eval(o, i, single, rng);
         guard(v, || {
             format!("{} eval(wo = {wo:?}, wi = {wi:?})", self.describe())
         })
@@ -455,8 +486,14 @@ impl OpaqueBsdf for InterfacedLambertian {
             return (single, single_se);
         }
         if let Some(q) = &self.ms_quadrature {
-            let ms = q.eval(i, o);
-            let se = (single_se * single_se + ms.error * ms.error).map(f64::sqrt);
+            let rest_error = self.deterministic_error(single_se);
+            let ms = q.eval_in(i, o, single, rest_error);
+            // Deterministic error bounds add; a standard error and a bound, in quadrature.
+            let se = if matches!(self.evaluation, BodyEvaluation::Adaptive { .. }) {
+                single_se + ms.error
+            } else {
+                (single_se * single_se + ms.error * ms.error).map(f64::sqrt)
+            };
             return (single + ms.value, se);
         }
         let (ms, ms_se) = crate::bsdf::mean_and_stderr(samples, || self.multiple(o, i, rng));
