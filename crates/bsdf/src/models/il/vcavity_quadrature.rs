@@ -946,8 +946,14 @@ impl VCavityQuadrature {
         }
     }
 
-    /// The inter-reflection part of the groove density at (θ_m, φ_m), every channel, without
-    /// the groove weight D(m) cos θ_m sin θ_m (remembered per node in `state`).
+    /// The groove weight 2 D(m) cos θ_m sin θ_m from the sines and cosines of θ_m and φ_m.
+    #[inline]
+    fn groove_weight(&self, (st, ct): (f64, f64), (sp, cp): (f64, f64)) -> f64 {
+        2.0 * self.ndf.d(Vec3::new(st * cp, st * sp, ct)) * ct * st
+    }
+
+    /// The inter-reflection part of the groove density at (θ_m, φ_m), every channel, with
+    /// the groove weight (remembered per node in `state`).
     fn galerkin_at(
         &self,
         theta: f64,
@@ -968,9 +974,14 @@ impl VCavityQuadrature {
                 op
             }
         };
-        self.trace_both(&op.wedge, i, o, phi.sin_cos(), &mut state.scratch);
+        let azimuth = phi.sin_cos();
+        let weight = self.groove_weight((op.wedge.s, op.wedge.c), azimuth);
         let mut out = [0.0; CHANNELS];
-        self.galerkin_density(&op, &mut state.scratch, &mut out);
+        if weight > 0.0 {
+            self.trace_both(&op.wedge, i, o, azimuth, &mut state.scratch);
+            self.galerkin_density(&op, &mut state.scratch, &mut out);
+            out = out.map(|v| weight * v);
+        }
         state.memo.insert(key, out);
         out
     }
@@ -1034,11 +1045,6 @@ impl VCavityQuadrature {
             hi: PI,
             breaks: azimuth_breaks(theta, i, o),
         };
-        // The groove weight 2 D(m) cos θ_m sin θ_m from the sines and cosines of θ_m and φ_m.
-        let weight_of = |(st, ct): (f64, f64), (sp, cp): (f64, f64)| {
-            2.0 * self.ndf.d(Vec3::new(st * cp, st * sp, ct)) * ct * st
-        };
-        let weight = |theta: f64, phi: f64| weight_of(theta.sin_cos(), phi.sin_cos());
         let mut scratch = Scratch::default();
         let dirac = self.specular_chains(i, o, &mut scratch);
         // The inner rule runs over φ at one θ: its wedge is made once.
@@ -1049,7 +1055,7 @@ impl VCavityQuadrature {
             }
             let w = &wedge.1;
             let azimuth = phi.sin_cos();
-            let weight = weight_of((w.s, w.c), azimuth);
+            let weight = self.groove_weight((w.s, w.c), azimuth);
             if !(weight > 0.0) {
                 return 0.0;
             }
@@ -1059,13 +1065,8 @@ impl VCavityQuadrature {
         // The inter-reflections, all channels at once, remembered per node: the pilot's
         // nodes are the first nodes of the final pass.
         let mut state = GalerkinState::default();
-        let mut galerkin_at = |theta: f64, phi: f64, ch: usize| {
-            let w = weight(theta, phi);
-            if !(w > 0.0) {
-                return 0.0;
-            }
-            w * self.galerkin_at(theta, phi, i, o, &mut state)[ch]
-        };
+        let mut galerkin_at =
+            |theta: f64, phi: f64, ch: usize| self.galerkin_at(theta, phi, i, o, &mut state)[ch];
         // Pilot: one pass of the first segments (no bisection, no azimuth breaks) for an
         // estimate of f_ms that sets the absolute error budget of both parts.
         let single_pass = Tolerance {
