@@ -352,8 +352,8 @@ impl InterfacedLambertian {
             ),
             BodyEvaluation::Adaptive { tolerance } => {
                 // With the multiple scattering by quadrature too, the body takes half of the
-                // tolerance and the inter-reflections what its error leaves of the other
-                // half (`multiple_eval`), so that f₁ + f_ms meets the tolerance.
+                // tolerance and the inter-reflections what the body's error estimate leaves
+                // of tolerance · (f₁ + f_ms) (`multiple_eval`), so that the value meets it.
                 let share = if self.ms_quadrature.is_some() {
                     0.5
                 } else {
