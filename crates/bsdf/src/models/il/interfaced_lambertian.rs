@@ -408,10 +408,16 @@ impl InterfacedLambertian {
     /// body quadrature's estimate; a stochastic body's standard error is noise of another
     /// kind, outside the tolerance.
     fn deterministic_error(&self, single_error: Spectrum) -> Spectrum {
-        match self.evaluation {
-            BodyEvaluation::Adaptive { .. } => single_error,
-            _ => Spectrum::ZERO,
+        if self.body_is_adaptive() {
+            single_error
+        } else {
+            Spectrum::ZERO
         }
+    }
+
+    /// Whether the body integral is the adaptive quadrature (its error a bound, not noise).
+    fn body_is_adaptive(&self) -> bool {
+        matches!(self.evaluation, BodyEvaluation::Adaptive { .. })
     }
 
     /// The multiple-scattering part (orders ≥ 2) for the upper-hemisphere pair: one V-cavity
@@ -489,7 +495,7 @@ impl OpaqueBsdf for InterfacedLambertian {
             let rest_error = self.deterministic_error(single_se);
             let ms = q.eval_in(i, o, single, rest_error);
             // Deterministic error bounds add; a standard error and a bound, in quadrature.
-            let se = if matches!(self.evaluation, BodyEvaluation::Adaptive { .. }) {
+            let se = if self.body_is_adaptive() {
                 single_se + ms.error
             } else {
                 (single_se * single_se + ms.error * ms.error).map(f64::sqrt)

@@ -202,6 +202,22 @@ struct Hit {
     d: (f64, f64),
 }
 
+impl Hit {
+    /// The transmitted density J⁰ on the footprint of a beam from i (power per unit facet
+    /// length entering the body); the footprint must have positive width.
+    #[inline]
+    fn entering_density(&self) -> f64 {
+        self.power / (self.u1 - self.u0) * (1.0 - self.f)
+    }
+
+    /// The exit weight E_o/c_b on the footprint of a beam traced from o: c_b T(q·m)(q·m) Φ/π
+    /// without c_b (see the module notes).
+    #[inline]
+    fn exit_weight(&self) -> f64 {
+        (1.0 - self.f) * self.cos * self.fres / PI
+    }
+}
+
 /// A beam leaving the groove after `bounces` specular reflections.
 #[derive(Clone, Copy, Debug)]
 struct Exit {
@@ -835,11 +851,10 @@ impl VCavityQuadrature {
         let second = self.orders == Orders::Second;
         let mut direct = 0.0;
         for a in &scratch.ih {
-            let wa = a.u1 - a.u0;
-            if !(wa > 0.0) {
+            if !(a.u1 > a.u0) {
                 continue;
             }
-            let jd = a.power / wa * (1.0 - a.f);
+            let jd = a.entering_density();
             for b in &scratch.oh {
                 if b.facet != a.facet {
                     continue;
@@ -854,7 +869,7 @@ impl VCavityQuadrature {
                 }
                 let ov = a.u1.min(b.u1) - a.u0.max(b.u0);
                 if ov > 0.0 {
-                    let e = (1.0 - b.f) * b.cos * b.fres / PI;
+                    let e = b.exit_weight();
                     direct += ov * jd * e;
                 }
             }
@@ -878,41 +893,32 @@ impl VCavityQuadrature {
         // equal ends merged and ends at the apex dropped (S(0, ·) = S(·, 0) = 0): footprints
         // often start at the apex or end at the rim, and each look-up saved is 16 products.
         let bounds = &op.bounds;
-        let collect =
-            |hits: &[Hit], weight: &dyn Fn(&Hit) -> f64, ends: &mut [Vec<(f64, f64)>; 2]| {
-                for e in ends.iter_mut() {
-                    e.clear();
+        let collect = |hits: &[Hit], weight: fn(&Hit) -> f64, ends: &mut [Vec<(f64, f64)>; 2]| {
+            for e in ends.iter_mut() {
+                e.clear();
+            }
+            for h in hits {
+                if (second && h.bounces > 0) || !(h.u1 > h.u0) {
+                    continue;
                 }
-                for h in hits {
-                    if (second && h.bounces > 0) || !(h.u1 > h.u0) {
-                        continue;
+                let w = weight(h);
+                ends[h.facet].push((h.u1, w));
+                ends[h.facet].push((h.u0, -w));
+            }
+            for e in ends.iter_mut() {
+                e.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                e.dedup_by(|b, a| {
+                    let same = a.0 == b.0;
+                    if same {
+                        a.1 += b.1;
                     }
-                    let w = weight(h);
-                    ends[h.facet].push((h.u1, w));
-                    ends[h.facet].push((h.u0, -w));
-                }
-                for e in ends.iter_mut() {
-                    e.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-                    e.dedup_by(|b, a| {
-                        let same = a.0 == b.0;
-                        if same {
-                            a.1 += b.1;
-                        }
-                        same
-                    });
-                    e.retain(|&(x, w)| x > 0.0 && w != 0.0);
-                }
-            };
-        collect(
-            &scratch.ih,
-            &|a| a.power / (a.u1 - a.u0) * (1.0 - a.f),
-            &mut scratch.src_ends,
-        );
-        collect(
-            &scratch.oh,
-            &|b| (1.0 - b.f) * b.cos * b.fres / PI,
-            &mut scratch.dst_ends,
-        );
+                    same
+                });
+                e.retain(|&(x, w)| x > 0.0 && w != 0.0);
+            }
+        };
+        collect(&scratch.ih, Hit::entering_density, &mut scratch.src_ends);
+        collect(&scratch.oh, Hit::exit_weight, &mut scratch.dst_ends);
         let abscissae = |ends: &[Vec<(f64, f64)>; 2], out: &mut [Vec<(f64, Abscissa)>; 2]| {
             for (e, o) in ends.iter().zip(out.iter_mut()) {
                 o.clear();
