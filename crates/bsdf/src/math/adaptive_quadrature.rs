@@ -11,6 +11,11 @@
 //!   microfacet integrals: the polar angles where a facet turns away from i or o, or where
 //!   the V-cavity masking changes branch, at each azimuth). Half of the tolerance goes to the
 //!   inner integrals, half to the outer rule.
+//! - [`integrate_2d_with_splits`]: the same with *split candidates* for the inner integrals,
+//!   points where f may have a kink but mostly a weak one (too many to pay a segment each
+//!   as breaks): a segment that needs bisecting and holds candidates is cut at the one
+//!   nearest its middle, and its halves skip the bisection floor below (cut at the kink,
+//!   they are smooth).
 //! - [`integrate_graded`], [`integrate_2d_graded`]: the same, with the range given as cuts
 //!   and each piece between cuts mapped by a cubic that clusters the nodes at its ends, for
 //!   integrands that behave like a square root at a cut (the albedo tables' entries).
@@ -131,6 +136,20 @@ fn cuts(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
     c
 }
 
+/// Where a segment is cut: at the candidate split point inside it nearest its midpoint
+/// (a known kink: one cut there leaves two smooth halves), else at the midpoint.
+fn split_point(a: f64, b: f64, splits: &[f64]) -> f64 {
+    let mid = 0.5 * (a + b);
+    let margin = 1e-9 * (b - a);
+    let lo = splits.partition_point(|&x| x <= a + margin);
+    let hi = splits.partition_point(|&x| x < b - margin);
+    splits[lo..hi]
+        .iter()
+        .copied()
+        .min_by(|x, y| (x - mid).abs().total_cmp(&(y - mid).abs()))
+        .unwrap_or(mid)
+}
+
 /// The adaptive driver for an integrand that returns (value, its own error estimate): the
 /// own errors (of inner integrals) are added to the result's error but do not steer the
 /// bisection, which their tolerance already bounds.
@@ -138,6 +157,19 @@ fn adaptive(
     a: f64,
     b: f64,
     breaks: &[f64],
+    tol: Tolerance,
+    f: &mut dyn FnMut(f64) -> (f64, f64),
+) -> QuadResult {
+    adaptive_with_splits(a, b, breaks, &mut Vec::new, tol, f)
+}
+
+/// [`adaptive`] with split candidates (see [`integrate_2d_with_splits`]), asked for at the
+/// first bisection.
+fn adaptive_with_splits(
+    a: f64,
+    b: f64,
+    breaks: &[f64],
+    splits: &mut dyn FnMut() -> Vec<f64>,
     tol: Tolerance,
     f: &mut dyn FnMut(f64) -> (f64, f64),
 ) -> QuadResult {
@@ -177,6 +209,8 @@ fn adaptive(
     };
     let (mut value, mut rule_err, mut node_err) = sum(&heap, &done);
     let mut converged = false;
+    // The split candidates, asked for at the first bisection.
+    let mut known: Option<Vec<f64>> = None;
     loop {
         let target = tol.target(value);
         // Met, or nothing left that bisection can improve (the inner errors dominate).
@@ -188,7 +222,12 @@ fn adaptive(
             break;
         }
         let Some(s) = heap.pop() else { break };
-        let mid = 0.5 * (s.a + s.b);
+        let known = known.get_or_insert_with(|| {
+            let mut v = splits();
+            v.sort_by(f64::total_cmp);
+            v
+        });
+        let mid = split_point(s.a, s.b, known);
         if !(mid > s.a && mid < s.b) {
             // At machine resolution: keep it, its error stays in the total.
             done.push(s);
@@ -200,7 +239,12 @@ fn adaptive(
         // rules see a kink or a peak they err alike and |K15 − G7| can fall below the true
         // error, but a child's error is then a fixed fraction (¼ for a kink) of its
         // parent's: half the difference is a floor for each child.
-        let floor = 0.5 * (s.value - l.value - r.value).abs();
+        // A cut at a known kink leaves two smooth halves: no floor there.
+        let floor = if mid == 0.5 * (s.a + s.b) {
+            0.5 * (s.value - l.value - r.value).abs()
+        } else {
+            0.0
+        };
         l.rule_error = l.rule_error.max(floor);
         r.rule_error = r.rule_error.max(floor);
         value += l.value + r.value - s.value;
@@ -248,7 +292,25 @@ pub fn integrate_2d(
     b: f64,
     outer_breaks: &[f64],
     tol: Tolerance,
+    inner: impl FnMut(f64) -> InnerRange,
+    f: impl FnMut(f64, f64) -> f64,
+) -> QuadResult {
+    integrate_2d_with_splits(a, b, outer_breaks, tol, inner, |_| Vec::new(), f)
+}
+
+/// [`integrate_2d`] with split candidates for the inner integrals: `splits(x)` lists the
+/// points in the inner range at x where f may have a kink — too many, or mostly too weak,
+/// to cut at each (a break costs a 15-node segment). It is asked for only when the inner
+/// rule at x first needs a segment bisected, and a segment that holds candidates is then
+/// cut at the one nearest its middle instead, without the bisection floor (the halves of
+/// a cut at the kink are smooth).
+pub fn integrate_2d_with_splits(
+    a: f64,
+    b: f64,
+    outer_breaks: &[f64],
+    tol: Tolerance,
     mut inner: impl FnMut(f64) -> InnerRange,
+    mut splits: impl FnMut(f64) -> Vec<f64>,
     mut f: impl FnMut(f64, f64) -> f64,
 ) -> QuadResult {
     let inner_tol = Tolerance {
@@ -261,9 +323,14 @@ pub fn integrate_2d(
     let mut inner_converged = true;
     let mut r = adaptive(a, b, outer_breaks, tol, &mut |x| {
         let range = inner(x);
-        let q = adaptive(range.lo, range.hi, &range.breaks, inner_tol, &mut |y| {
-            (f(x, y), 0.0)
-        });
+        let q = adaptive_with_splits(
+            range.lo,
+            range.hi,
+            &range.breaks,
+            &mut || splits(x),
+            inner_tol,
+            &mut |y| (f(x, y), 0.0),
+        );
         evaluations += q.evaluations;
         inner_converged &= q.converged;
         (q.value, q.error)
@@ -525,6 +592,61 @@ mod tests {
         );
         assert!(!q.converged && q.error > 0.0);
         assert!((q.value - 2.0 / 3.0).abs() <= q.error);
+    }
+
+    #[test]
+    fn kinks_given_as_split_candidates_cost_less_than_bisection_and_keep_the_bound() {
+        // ∫_0^1 ∫_0^π Σ_k |cos(y − c_k(x))| w_k dy dx with kinks at y = c_k(x) ± π/2 that
+        // move with x; the candidates hold the kinks of the strong terms and spurious
+        // points besides (a candidate that is no kink costs nothing when no bisection
+        // needs it).
+        let weights = [1.0, 0.3, 1e-3, 1e-6];
+        let centre = |k: usize, x: f64| 0.4 + 0.7 * k as f64 + 0.3 * x;
+        let f = |x: f64, y: f64| -> f64 {
+            (0..4)
+                .map(|k| weights[k] * (y - centre(k, x)).cos().abs())
+                .sum()
+        };
+        // ∫_0^π |cos(y − c)| dy = 2 for every c.
+        let exact = 2.0 * weights.iter().sum::<f64>();
+        let range = |_| InnerRange {
+            lo: 0.0,
+            hi: PI,
+            breaks: vec![],
+        };
+        let kinks = |x: f64| {
+            let mut v: Vec<f64> = (0..4)
+                .flat_map(|k| {
+                    let c = centre(k, x) + 0.5 * PI;
+                    [c.rem_euclid(PI), c.rem_euclid(PI) + 0.01, 2.9 - x]
+                })
+                .collect();
+            v.push(1.234);
+            v
+        };
+        for rel in [1e-5, 1e-8] {
+            let tol = Tolerance {
+                rel,
+                abs: 0.0,
+                max_segments: 400,
+                estimate: ErrorEstimate::Embedded,
+            };
+            let plain = integrate_2d(0.0, 1.0, &[], tol, range, f);
+            let split = integrate_2d_with_splits(0.0, 1.0, &[], tol, range, kinks, f);
+            for q in [plain, split] {
+                let err = (q.value - exact).abs();
+                assert!(
+                    q.converged && err <= q.error && err <= rel * exact,
+                    "{rel}: {q:?} vs {exact}"
+                );
+            }
+            assert!(
+                2 * split.evaluations < plain.evaluations,
+                "{rel}: {} vs {} evaluations",
+                split.evaluations,
+                plain.evaluations
+            );
+        }
     }
 
     #[test]

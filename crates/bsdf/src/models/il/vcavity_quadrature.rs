@@ -83,25 +83,31 @@
 //! **Accuracy.** The groove-orientation integral carries the adaptive rule's error estimate
 //! (tolerance relative to f_ms with [`VCavityQuadrature::eval`], relative to the whole BRDF
 //! value f₁ + f_ms with [`VCavityQuadrature::eval_in`], which IL's `eval` uses), as two
-//! integrals: the direct part ⟨E_o, J⁰⟩ (kinked where footprint ends cross, cheap: no
-//! operator, cut at the azimuth breaks when its budget is below 1e-3 of its value) and the
-//! inter-reflections ⟨E_o, 𝒜J⁰⟩ (smooth, dear, integrated without azimuth breaks: each
-//! would cost a 15-node segment, and their kinks are weak there), sharing one absolute error
-//! budget set by a pilot estimate of f_ms (see [`VCavityQuadrature::eval`]), their errors
-//! added. The per-segment estimate is
-//! the embedded |K15 − G7| ([`ErrorEstimate::Embedded`]) rather than QUADPACK's scaled one,
-//! which overstated the error 50–100× here; the footprint crossings are not given to the
-//! rule as breaks (locating them cost more than it saved), and the bisection floor catches
-//! them: against a 1e-6 reference the estimate was 1.6–70× the actual error at tolerance
-//! 1e-3 and 8–30× at 1e-4 (the test below checks two pairs). Grooves steeper than 90° − ψ_min/2 (ψ_min = 4°, i.e.
-//! θ_m > 88°) are not followed; their share of the projected area is measured at
+//! integrals: the direct part ⟨E_o, J⁰⟩ (kinked where footprint ends cross and where a
+//! beam changes shape, cheap: no operator) and the inter-reflections ⟨E_o, 𝒜J⁰⟩ (smooth in
+//! the footprint ends, kinked only where a beam changes shape, dear), sharing one absolute
+//! error budget set by a pilot estimate of f_ms (see [`VCavityQuadrature::eval`]), their
+//! errors added. The azimuths where a beam changes shape (`azimuth_breaks`) are given to
+//! both inner rules as split candidates ([`integrate_2d_with_splits`]), not as breaks: a
+//! segment the rule would bisect is cut at the one nearest its middle, so a kink that
+//! matters costs one cut and a weak one nothing (as breaks each cost a 15-node segment,
+//! and made the inter-reflections 4× dearer). The per-segment estimate is the embedded
+//! |K15 − G7| ([`ErrorEstimate::Embedded`]) rather than QUADPACK's scaled one, which
+//! overstated the error 50–100× here; the footprint crossings are not given to the rule
+//! (located exactly — a degree-2 trigonometric equation per pair of ends — as split
+//! candidates they saved a further 20–25 % of the direct part's evaluations but cost 6×
+//! the time), and the bisection floor catches them: against a 1e-7 reference the estimate
+//! was 2–17× the actual error at tolerance 1e-4 (the test below checks two pairs).
+//! Grooves steeper than 90° − ψ_min/2 (ψ_min = 4°, i.e. θ_m > 88°) are not followed; their share of the projected area is measured at
 //! construction ([`VCavityQuadrature::neglected_fraction`]) and is below 1e-6 for Beckmann
 //! α ≤ 1.2. The Galerkin discretisation error is set by the cell count (second order; the
 //! tests compare it with the random walk and check energy conservation).
 
 use super::vcavity::Orders;
 use crate::fresnel::fresnel_dielectric;
-use crate::math::adaptive_quadrature::{integrate_2d, ErrorEstimate, InnerRange, Tolerance};
+use crate::math::adaptive_quadrature::{
+    integrate_2d, integrate_2d_with_splits, ErrorEstimate, InnerRange, Tolerance,
+};
 use crate::math::quadrature::GaussLegendre;
 use crate::math::spectrum::{Spectrum, CHANNELS};
 use crate::math::{Vec3, PI};
@@ -123,9 +129,6 @@ const GAMMA_GL: usize = 12;
 const TABLE_INTERVALS: usize = 128;
 /// Cap on specular bounces of a beam (never reached for ψ ≥ ψ_min).
 const MAX_BOUNCES: usize = 400;
-/// The direct part is cut at the azimuth breaks only when its absolute error budget is
-/// below this fraction of its pilot value (see [`VCavityQuadrature::eval_in`]).
-const AZIMUTH_BREAKS_BELOW: f64 = 1e-3;
 /// Most cached groove operators.
 const CACHE_LIMIT: usize = 8192;
 
@@ -1001,7 +1004,7 @@ impl VCavityQuadrature {
     /// inter-reflections (smooth in the footprint ends through the C¹ cumulative tables,
     /// dear per evaluation, few evaluations). Both share one absolute error budget,
     /// 0.9 · tolerance · f_ms, f_ms estimated by a pilot pass (the first segments of both
-    /// integrals, no bisection, no azimuth breaks): the inter-reflections get half of it and
+    /// integrals, no bisection): the inter-reflections get half of it and
     /// the direct part what they leave. Inner integrals then stop at an absolute target, so a
     /// groove tilt that carries little of f_ms is not integrated to a relative tolerance of
     /// its own. The reported error is the sum of the two estimates; `converged` says whether
@@ -1039,18 +1042,14 @@ impl VCavityQuadrature {
             max_segments: 200,
             estimate: ErrorEstimate::Embedded,
         };
-        // The inter-reflections are smooth in the footprint ends (C¹ cumulative tables):
-        // the footprints' kinks are too weak there to pay a 15-node segment each.
+        // Both parts are cut where a beam changes shape only when a segment there needs
+        // bisecting (see the module notes).
         let whole_circle = |_| InnerRange {
             lo: 0.0,
             hi: PI,
             breaks: Vec::new(),
         };
-        let azimuths = |theta| InnerRange {
-            lo: 0.0,
-            hi: PI,
-            breaks: azimuth_breaks(theta, i, o),
-        };
+        let splits = |theta| azimuth_breaks(theta, i, o);
         let mut scratch = Scratch::default();
         let dirac = self.specular_chains(i, o, &mut scratch);
         // The inner rule runs over φ at one θ: its wedge is made once.
@@ -1073,7 +1072,7 @@ impl VCavityQuadrature {
         let mut state = GalerkinState::default();
         let mut galerkin_at =
             |theta: f64, phi: f64, ch: usize| self.galerkin_at(theta, phi, i, o, &mut state)[ch];
-        // Pilot: one pass of the first segments (no bisection, no azimuth breaks) for an
+        // Pilot: one pass of the first segments (no bisection) for an
         // estimate of f_ms that sets the absolute error budget of both parts.
         let single_pass = Tolerance {
             max_segments: 1,
@@ -1099,9 +1098,15 @@ impl VCavityQuadrature {
             .take(channels)
         {
             let mut galerkin_part = |tol: Tolerance| {
-                integrate_2d(0.0, self.theta_max, &breaks, tol, whole_circle, |t, p| {
-                    galerkin_at(t, p, ch)
-                })
+                integrate_2d_with_splits(
+                    0.0,
+                    self.theta_max,
+                    &breaks,
+                    tol,
+                    whole_circle,
+                    splits,
+                    |t, p| galerkin_at(t, p, ch),
+                )
             };
             let pilot = galerkin_part(single_pass);
             let cb = self.body_factor.0[ch];
@@ -1140,22 +1145,15 @@ impl VCavityQuadrature {
             abs: direct_budget.max(tol.abs),
             ..tol
         };
-        // The azimuth breaks pay only where the direct part is wanted to better than about
-        // 1e-3 of itself: each costs a 15-node segment (docs/performance.md: over the bench's
-        // pairs, thresholds 1e-4 … 1 against tolerances 1e-3 … 1e-5, this one was the
-        // cheapest or within 1 % of it everywhere).
-        let direct = if direct_budget < AZIMUTH_BREAKS_BELOW * pilot_direct.value.abs() {
-            integrate_2d(0.0, self.theta_max, &breaks, part, azimuths, &mut direct_at)
-        } else {
-            integrate_2d(
-                0.0,
-                self.theta_max,
-                &breaks,
-                part,
-                whole_circle,
-                &mut direct_at,
-            )
-        };
+        let direct = integrate_2d_with_splits(
+            0.0,
+            self.theta_max,
+            &breaks,
+            part,
+            whole_circle,
+            splits,
+            &mut direct_at,
+        );
         evaluations += direct.evaluations;
         let mut converged = true;
         for (c, &(g, eg)) in galerkin.iter().enumerate() {
