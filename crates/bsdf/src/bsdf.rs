@@ -142,6 +142,15 @@ pub trait Bsdf: Send + Sync {
         false
     }
 
+    /// True when `eval` (and so `eval_estimate`, whatever its `samples`) returns one value
+    /// for a direction pair, whatever the random numbers: closed forms, and models that
+    /// evaluate by quadrature while their `sample` weights stay stochastic (so that they
+    /// are [`Self::is_stochastic`] for the consistency checks). Tools that average
+    /// estimates or keep one random stream in order ask this.
+    fn eval_is_deterministic(&self) -> bool {
+        !self.is_stochastic()
+    }
+
     /// f(wo, wi) without the cosine factor; excludes delta lobes.
     fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum;
 

@@ -26,6 +26,11 @@ pub trait OpaqueBsdf: Send + Sync {
         false
     }
 
+    /// See [`Bsdf::eval_is_deterministic`].
+    fn eval_is_deterministic(&self) -> bool {
+        !self.is_stochastic()
+    }
+
     /// f(wo, wi) without the cosine factor; `wo.z > 0`, `wi.z > 0`.
     fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum;
 
@@ -105,6 +110,10 @@ impl<M: OpaqueBsdf> Bsdf for TwoSided<M> {
 
     fn is_stochastic(&self) -> bool {
         self.inner.is_stochastic()
+    }
+
+    fn eval_is_deterministic(&self) -> bool {
+        self.inner.eval_is_deterministic()
     }
 
     fn eval(&self, wo: Vec3, wi: Vec3, ctx: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {

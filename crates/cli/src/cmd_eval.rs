@@ -110,7 +110,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
         ),
         None => (Box::new(std::io::stdin().lock()), "stdin".to_string()),
     };
-    if bsdf.is_stochastic() {
+    if !bsdf.eval_is_deterministic() {
         eprintln!(
             "note: {} is evaluated stochastically; each value averages {} independent estimates",
             bsdf.describe(),

@@ -175,7 +175,7 @@ fn materials(m: &MaterialsArgs) -> Result<Vec<LabelledBsdf>> {
         .map(|(k, text)| {
             let bsdf = parse_material(text)
                 .with_context(|| format!("material {} of {}", k + 1, m.materials.len()))?;
-            if bsdf.is_stochastic() {
+            if !bsdf.eval_is_deterministic() {
                 eprintln!(
                     "note: {} is evaluated stochastically; each value averages {} estimates",
                     bsdf.describe(),

@@ -106,7 +106,11 @@ fn describe(frame: Frame, bsdf: &dyn Bsdf, text: &str) -> Frame {
 
 /// f (or f·|cos θ_o|) and its standard error at `wo` for light from `wi`, per channel.
 fn value(bsdf: &dyn Bsdf, wi: Vec3, wo: Vec3, q: Quantity, samples: usize, seed: u64) -> [f64; 6] {
-    let n = if bsdf.is_stochastic() { samples } else { 1 };
+    let n = if bsdf.eval_is_deterministic() {
+        1
+    } else {
+        samples
+    };
     let mut rng = Pcg32::new(seed, 3);
     let (f, se) = bsdf.eval_estimate(wo, wi, &BsdfContext::RADIANCE, n, &mut rng);
     let w = q.weight(wo);

@@ -16,7 +16,7 @@ pub fn measure_material(material: &dyn Bsdf, noise: f64, seed: u64) -> MerlBrdf 
     let ctx = BsdfContext::RADIANCE;
     let m = MerlBrdf::from_fn(|k, i, o| {
         let mut rng = Pcg32::new(mix_seed(seed, k as u64), 7);
-        Some(if material.is_stochastic() {
+        Some(if !material.eval_is_deterministic() {
             material
                 .eval_estimate(o, i, &ctx, STOCHASTIC_SAMPLES, &mut rng)
                 .0

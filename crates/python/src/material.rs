@@ -140,7 +140,8 @@ impl Material {
         self.bsdf.describe()
     }
 
-    /// Whether `eval` is a stochastic (unbiased) estimate.
+    /// Whether the model is stochastic: its `eval` an unbiased estimate, or (IL with both
+    /// quadratures) its sampling weights only, `eval` then being deterministic.
     #[getter]
     fn is_stochastic(&self) -> bool {
         self.bsdf.is_stochastic()
@@ -214,14 +215,14 @@ impl Material {
         let bsdf = self.bsdf.clone();
         // A stochastic row costs `samples` evaluations.
         let work = wi.len()
-            * if self.bsdf.is_stochastic() {
-                samples
-            } else {
+            * if self.bsdf.eval_is_deterministic() {
                 1
+            } else {
+                samples
             };
         let small = work <= CHUNK;
         let rows = run_small_or_all(py, "facette.Material.eval", progress, small, move |c| {
-            if bsdf.is_stochastic() {
+            if !bsdf.eval_is_deterministic() {
                 // One stream through the rows, in order: `facette eval`'s values.
                 c.set_total(wi.len() as u64);
                 let mut rng = Pcg32::new(seed, 0);

@@ -247,3 +247,43 @@ fn coloured_substrates_are_three_grey_ones() {
     }
     assert!(c.value[0] < c.value[1] && c.value[1] < c.value[2]);
 }
+
+#[test]
+fn il_wholly_by_quadrature_evaluates_deterministically() {
+    // Body and inter-reflections by quadrature: `eval` draws no random numbers (its value
+    // is the same from two streams), so the tools evaluate it once per pair and in
+    // parallel, while `sample` still carries one walk (the model stays stochastic for the
+    // consistency checks). With the walk, or a sampled body, `eval` is an estimate.
+    let ndf = || Ndf::Beckmann(Beckmann::isotropic(0.5).unwrap());
+    let build = |body: BodyEvaluation, quadrature: bool| {
+        let m = InterfacedLambertian::new(
+            Spectrum::splat(0.8),
+            1.5,
+            Some(SpecularLobe::new(ndf(), Masking::VCavity, NormalSampling::Visible).unwrap()),
+            body,
+            Scattering::Multiple,
+        )
+        .unwrap();
+        TwoSided::new(if quadrature {
+            m.with_multiple_quadrature(1e-3).unwrap()
+        } else {
+            m
+        })
+    };
+    let adaptive = || BodyEvaluation::Adaptive { tolerance: 1e-4 };
+    let (wo, wi) = (spherical_direction(0.4, 0.0), spherical_direction(0.9, 2.0));
+    let ctx = BsdfContext::RADIANCE;
+    let exact = build(adaptive(), true);
+    assert!(exact.is_stochastic() && exact.eval_is_deterministic());
+    let a = exact.eval(wo, wi, &ctx, &mut Pcg32::new(1, 1));
+    let b = exact.eval(wo, wi, &ctx, &mut Pcg32::new(2, 7));
+    assert_eq!(a, b);
+    assert!(a[1] > 0.0);
+    for (body, quadrature) in [(adaptive(), false), (BodyEvaluation::Stochastic, true)] {
+        let m = build(body, quadrature);
+        assert!(m.is_stochastic() && !m.eval_is_deterministic());
+        let a = m.eval(wo, wi, &ctx, &mut Pcg32::new(1, 1));
+        let b = m.eval(wo, wi, &ctx, &mut Pcg32::new(2, 7));
+        assert_ne!(a, b);
+    }
+}

@@ -412,6 +412,29 @@ fn eval_with_error_prints_the_quadrature_error_or_the_standard_error() {
 }
 
 #[test]
+fn eval_notes_stochastic_values_only() {
+    // IL with the body and the inter-reflections by quadrature evaluates deterministically
+    // (only its sampling weights carry a walk): no note about averaged estimates, the same
+    // value from two seeds; with the walk, the note.
+    let base = r#"type = "il", kd = 0.8, ni = 1.5, distribution = "beckmann", alpha = 0.5, scattering = "multiple", evaluation = "quadrature", tolerance = 1e-3"#;
+    let pair = Some("40,0,30,150\n");
+    let exact = format!("{{{base}, multiple_evaluation = \"quadrature\"}}");
+    let run = |m: &str, seed: &str| facette(&["eval", "--material", m, "--seed", seed], pair);
+    let (a, b) = (run(&exact, "1"), run(&exact, "2"));
+    assert!(a.status.success(), "{}", stderr(&a));
+    assert!(!stderr(&a).contains("stochastically"), "{}", stderr(&a));
+    assert_eq!(rows(&a), rows(&b));
+    let walk = format!("{{{base}}}");
+    let o = facette(&["eval", "--material", &walk, "--samples", "200"], pair);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is evaluated stochastically; each value averages 200"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn quadrature_keys_are_checked_by_name() {
     let base = r#"type = "il", distribution = "beckmann", alpha = 0.3"#;
     for (extra, expect) in [

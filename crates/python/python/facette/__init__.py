@@ -159,7 +159,9 @@ class Material:
 
     @property
     def is_stochastic(self):
-        """Whether ``eval`` is an unbiased stochastic estimate (IL, exact Oren-Nayar)."""
+        """Whether the model is stochastic (IL, exact Oren-Nayar): its ``eval`` an unbiased
+        estimate, or, for IL with ``evaluation = "quadrature"`` and ``multiple_evaluation =
+        "quadrature"``, only its sampling weights (``eval`` is then deterministic)."""
         return self._m.is_stochastic
 
     @property
@@ -197,10 +199,10 @@ class Material:
         the local frame (z the normal), broadcast against each other (a (3,) direction
         against (N, 3), (H, W, 3) grids, …); they are normalized. ``cosine=False`` (the
         default) returns the BSDF alone; ``cosine=True`` multiplies it by |cos θ_i| = |wi.z|
-        (Mitsuba 3's ``eval``). Stochastic materials (``is_stochastic``) average
-        ``samples`` estimates per row from one stream seeded by ``seed``, in row order (the
-        values ``facette eval`` prints), on one thread; the others run on ``threads``
-        threads (all cores by default; results do not depend on it). ``mode`` is
+        (Mitsuba 3's ``eval``). Materials whose ``eval`` is stochastic (``is_stochastic``,
+        except IL evaluated wholly by quadrature) average ``samples`` estimates per row from
+        one stream seeded by ``seed``, in row order (the values ``facette eval`` prints), on
+        one thread; the others run on ``threads`` threads (all cores by default; results do not depend on it). ``mode`` is
         "radiance" or "importance" (they differ for refraction). ``progress``: True prints
         the rows done on stderr, a callable receives ``(done, total)``.
 

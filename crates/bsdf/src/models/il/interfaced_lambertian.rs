@@ -469,6 +469,12 @@ impl OpaqueBsdf for InterfacedLambertian {
                 || self.scattering != Scattering::Single)
     }
 
+    fn eval_is_deterministic(&self) -> bool {
+        self.lobe.is_none()
+            || (!matches!(self.evaluation, BodyEvaluation::Stochastic)
+                && (self.scattering == Scattering::Single || self.ms_quadrature.is_some()))
+    }
+
     fn eval(&self, wo: Vec3, wi: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Spectrum {
         let (o, i) = (wo, wi);
         let single = self.single(o, i, 1, rng);
