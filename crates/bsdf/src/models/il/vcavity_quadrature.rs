@@ -351,25 +351,14 @@ impl ChainTable {
     fn new(j: usize, psi: f64, ni: f64, gamma: &GaussLegendre) -> Self {
         let delta = (j + 1) as f64 * psi;
         let step = (PI - delta) / TABLE_INTERVALS as f64;
-        let values = (0..=TABLE_INTERVALS)
-            .map(|n| {
-                let omega = delta + step * n as f64;
-                let mut g = 0.0;
-                for (&x, &wx) in gamma.nodes.iter().zip(&gamma.weights) {
-                    let gam = 0.25 * PI * (x + 1.0);
-                    let cg = gam.cos();
-                    let t = |c: f64| 1.0 - fresnel_dielectric(c, ni);
-                    let mut v =
-                        cg * cg * t(omega.sin().abs() * cg) * t((omega - delta).sin().abs() * cg);
-                    for l in 1..=j {
-                        v *= fresnel_dielectric((omega - l as f64 * psi).sin().abs() * cg, ni);
-                    }
-                    g += wx * v;
-                }
-                // 2 ∫₀^{π/2} … dγ with the rule mapped from [−1, 1].
-                2.0 * 0.25 * PI * g
-            })
+        // Reciprocity: g_j(ω) = g_j(π + Δ − ω) (the chain walked backwards; ℓ ↦ j + 1 − ℓ),
+        // and node n mirrors node N − n: half the table is computed.
+        let mut values: Vec<f64> = (0..=TABLE_INTERVALS / 2)
+            .map(|n| Self::g_at(j, psi, ni, gamma, delta + step * n as f64))
             .collect();
+        for n in (0..TABLE_INTERVALS.div_ceil(2)).rev() {
+            values.push(values[n]);
+        }
         let check = (j >= 1).then(|| {
             let first = psi;
             let last = j as f64 * psi;
@@ -386,6 +375,23 @@ impl ChainTable {
             step,
             values,
         }
+    }
+
+    /// g_j(ω) by the elevation rule `gamma` (see the module notes).
+    fn g_at(j: usize, psi: f64, ni: f64, gamma: &GaussLegendre, omega: f64) -> f64 {
+        let delta = (j + 1) as f64 * psi;
+        let t = |c: f64| 1.0 - fresnel_dielectric(c, ni);
+        let mut g = 0.0;
+        for (&x, &wx) in gamma.nodes.iter().zip(&gamma.weights) {
+            let cg = (0.25 * PI * (x + 1.0)).cos();
+            let mut v = cg * cg * t(omega.sin().abs() * cg) * t((omega - delta).sin().abs() * cg);
+            for l in 1..=j {
+                v *= fresnel_dielectric((omega - l as f64 * psi).sin().abs() * cg, ni);
+            }
+            g += wx * v;
+        }
+        // 2 ∫₀^{π/2} … dγ with the rule mapped from [−1, 1].
+        2.0 * 0.25 * PI * g
     }
 
     #[inline]
@@ -569,11 +575,13 @@ impl GrooveOperator {
             .collect();
         let gl = GaussLegendre::new(cell_gl);
         // Galerkin: M[c][c'] = (1/|c|)∫_c ∫_c' K; same facet: odd j, other facet: even j.
+        // K is symmetric (reciprocity, g_j's mirror symmetry), and so is the product rule:
+        // M[c'][c] = M[c][c']·|c|/|c'|, half the cell pairs computed.
         let mut same = vec![0.0; n * n];
         let mut other = vec![0.0; n * n];
         for c in 0..n {
             let (a, b) = (bounds[c], bounds[c + 1]);
-            for cp in 0..n {
+            for cp in c..n {
                 let (ap, bp) = (bounds[cp], bounds[cp + 1]);
                 let (mut s_same, mut s_other) = (0.0, 0.0);
                 for (&x, &wx) in gl.nodes.iter().zip(&gl.weights) {
@@ -593,6 +601,9 @@ impl GrooveOperator {
                 }
                 same[c * n + cp] = s_same;
                 other[c * n + cp] = s_other;
+                let ratio = (b - a) / (bp - ap);
+                same[cp * n + c] = s_same * ratio;
+                other[cp * n + c] = s_other * ratio;
             }
         }
         let full = |cb: f64| {
@@ -1451,6 +1462,32 @@ mod tests {
             assert!(actual <= v.error[1] + reference.error[1], "{line}");
             assert!(v.evaluations < own.evaluations, "{line}");
             println!("{line}");
+        }
+    }
+
+    #[test]
+    fn chain_tables_are_their_mirror_images() {
+        // Reciprocity, g_j(ω) = g_j(π + Δ − ω): the half of each table that is mirrored
+        // equals the formula there, to rounding (of the table's peak).
+        let gamma = GaussLegendre::new(GAMMA_GL);
+        for (theta, ni) in [(0.4, 1.5), (1.2, 2.0), (1.5, 1.2)] {
+            let psi = PI - 2.0 * theta;
+            for j in [0, 1, 2, 5] {
+                if (j + 1) as f64 * psi >= PI {
+                    continue;
+                }
+                let table = ChainTable::new(j, psi, ni, &gamma);
+                let peak = table.values.iter().fold(0.0f64, |a, &b| a.max(b));
+                assert!(peak > 0.0);
+                for (n, &v) in table.values.iter().enumerate() {
+                    let omega = table.delta + table.step * n as f64;
+                    let exact = ChainTable::g_at(j, psi, ni, &gamma, omega);
+                    assert!(
+                        (v - exact).abs() <= 1e-12 * peak,
+                        "θ {theta}, j {j}, node {n}: {v} vs {exact}"
+                    );
+                }
+            }
         }
     }
 
