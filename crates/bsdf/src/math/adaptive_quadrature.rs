@@ -15,7 +15,10 @@
 //!   points where f may have a kink but mostly a weak one (too many to pay a segment each
 //!   as breaks): a segment that needs bisecting and holds candidates is cut at the one
 //!   nearest its middle, and its halves skip the bisection floor below (cut at the kink,
-//!   they are smooth).
+//!   they are taken as smooth; one that still holds candidates is cut at one of them in
+//!   turn if it needs bisecting). Keeping the floor for such halves cost 15–30 % more
+//!   evaluations on the V-cavity quadrature, whose reported error stayed 2.3–17× the
+//!   actual one without it.
 //! - [`integrate_graded`], [`integrate_2d_graded`]: the same, with the range given as cuts
 //!   and each piece between cuts mapped by a cubic that clusters the nodes at its ends, for
 //!   integrands that behave like a square root at a cut (the albedo tables' entries).

@@ -98,10 +98,11 @@
 //! candidates they saved a further 20–25 % of the direct part's evaluations but cost 6×
 //! the time), and the bisection floor catches them: against a 1e-7 reference the estimate
 //! was 2–17× the actual error at tolerance 1e-4 (the test below checks two pairs).
-//! Grooves steeper than 90° − ψ_min/2 (ψ_min = 4°, i.e. θ_m > 88°) are not followed; their share of the projected area is measured at
-//! construction ([`VCavityQuadrature::neglected_fraction`]) and is below 1e-6 for Beckmann
-//! α ≤ 1.2. The Galerkin discretisation error is set by the cell count (second order; the
-//! tests compare it with the random walk and check energy conservation).
+//! Grooves steeper than 90° − ψ_min/2 (ψ_min = 4°, i.e. θ_m > 88°) are not followed;
+//! their share of the projected area is measured at construction
+//! ([`VCavityQuadrature::neglected_fraction`]) and is below 1e-6 for Beckmann α ≤ 1.2. The
+//! Galerkin discretisation error is set by the cell count (second order; the tests compare
+//! it with the random walk and check energy conservation).
 
 use super::vcavity::Orders;
 use crate::fresnel::fresnel_dielectric;
