@@ -53,6 +53,10 @@ def test_eval_equals_the_cli(facette_bin, spec, samples):
     [
         # Adaptive quadrature: the error column is its error estimate.
         ('{type = "il", kd = 0.7, ni = 1.5, alpha = 0.4, evaluation = "quadrature", tolerance = 1e-4}', 1),
+        # IL_∞ wholly by quadrature: deterministic (rows on all threads) though stochastic
+        # as a model (its sampling weights carry a walk).
+        ('{type = "il", kd = 0.7, ni = 1.5, alpha = 0.4, evaluation = "quadrature", tolerance = 1e-3, '
+         'scattering = "multiple", multiple_evaluation = "quadrature"}', 1),
         # Stochastic: the standard error of the mean.
         ('{type = "il", kd = 0.7, ni = 1.5, alpha = 0.4}', 300),
         # Closed form: zero.
@@ -70,6 +74,9 @@ def test_eval_with_error_equals_the_cli(facette_bin, spec, samples):
     # The CLI prints errors with 4 significant digits.
     np.testing.assert_allclose(err, cli[:, 3:], rtol=1e-3, atol=1e-300)
     np.testing.assert_array_equal(m.eval(wi, wo, samples=samples, seed=4), f)
+    if "multiple_evaluation" in spec:
+        assert m.is_stochastic
+        np.testing.assert_array_equal(m.eval(wi, wo, seed=9, threads=1), f)
     if "conductor" in spec:
         assert (err == 0).all()
     else:
