@@ -1379,11 +1379,8 @@ mod tests {
         // against 2.9e-6 at 1e-3 when measured).
         use crate::math::spherical_direction;
         use crate::microfacet::Beckmann;
-        let cb = 0.8
-            / (1.5
-                * 1.5
-                * (1.0
-                    - 0.8 * crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5)));
+        let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
+        let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri)[0];
         for (alpha, (to, ti, pi)) in [(0.5, (0.2, 1.0, 1.0)), (1.2, (0.9, 1.2, 0.5))] {
             let q = |tol| {
                 VCavityQuadrature::new(
@@ -1420,11 +1417,8 @@ mod tests {
         // groove densities are evaluated than for the same tolerance relative to f_ms alone.
         use crate::math::spherical_direction;
         use crate::microfacet::Beckmann;
-        let cb = 0.8
-            / (1.5
-                * 1.5
-                * (1.0
-                    - 0.8 * crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5)));
+        let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
+        let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri)[0];
         let q = |tol| {
             VCavityQuadrature::new(
                 Ndf::Beckmann(Beckmann::isotropic(0.5).unwrap()),
