@@ -126,7 +126,7 @@ impl Ord for Segment {
 
 /// Sorted, deduplicated cut points of [a, b] including both ends (breaks outside (a, b)
 /// and non-finite ones are ignored).
-fn cuts(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
+pub(crate) fn cuts(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
     let mut c: Vec<f64> = breaks
         .iter()
         .copied()
@@ -141,7 +141,7 @@ fn cuts(a: f64, b: f64, breaks: &[f64]) -> Vec<f64> {
 
 /// Where a segment is cut: at the candidate split point inside it nearest its midpoint
 /// (a known kink: one cut there leaves two smooth halves), else at the midpoint.
-fn split_point(a: f64, b: f64, splits: &[f64]) -> f64 {
+pub(crate) fn split_point(a: f64, b: f64, splits: &[f64]) -> f64 {
     let mid = 0.5 * (a + b);
     let margin = 1e-9 * (b - a);
     let lo = splits.partition_point(|&x| x <= a + margin);

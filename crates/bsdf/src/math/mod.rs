@@ -10,6 +10,7 @@
 pub mod adaptive_quadrature;
 pub mod complex;
 pub mod cosine_lobe;
+pub mod nested_quadrature;
 pub mod quadrature;
 pub mod rng;
 pub mod sin_cos;

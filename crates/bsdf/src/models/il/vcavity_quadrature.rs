@@ -83,21 +83,23 @@
 //! **Accuracy.** The groove-orientation integral carries the adaptive rule's error estimate
 //! (tolerance relative to f_ms with [`VCavityQuadrature::eval`], relative to the whole BRDF
 //! value f₁ + f_ms with [`VCavityQuadrature::eval_in`], which IL's `eval` uses), as two
-//! integrals: the direct part ⟨E_o, J⁰⟩ (kinked where footprint ends cross and where a
-//! beam changes shape, cheap: no operator) and the inter-reflections ⟨E_o, 𝒜J⁰⟩ (smooth in
-//! the footprint ends, kinked only where a beam changes shape, dear), sharing one absolute
-//! error budget set by a pilot estimate of f_ms (see [`VCavityQuadrature::eval`]), their
-//! errors added. The azimuths where a beam changes shape (`azimuth_breaks`) are given to
-//! both inner rules as split candidates ([`integrate_2d_with_splits`]), not as breaks: a
-//! segment the rule would bisect is cut at the one nearest its middle, so a kink that
-//! matters costs one cut and a weak one nothing (as breaks each cost a 15-node segment,
-//! and made the inter-reflections 4× dearer). The per-segment estimate is the embedded
-//! |K15 − G7| ([`ErrorEstimate::Embedded`]) rather than QUADPACK's scaled one, which
-//! overstated the error 50–100× here; the footprint crossings are not given to the rule
-//! (located exactly — a degree-2 trigonometric equation per pair of ends — as split
-//! candidates they saved a further 20–25 % of the direct part's evaluations but cost 6×
-//! the time), and the bisection floor catches them: against a 1e-7 reference the estimate
-//! was 2–17× the actual error at tolerance 1e-4 (the test below checks two pairs).
+//! parts of one globally adaptive [`NestedQuadrature`]: the direct part ⟨E_o, J⁰⟩ (kinked
+//! where footprint ends cross and where a beam changes shape, cheap: no operator) and the
+//! inter-reflections ⟨E_o, 𝒜J⁰⟩ (smooth in the footprint ends, kinked only where a beam
+//! changes shape, dear). One absolute error budget, set from their first segments and the
+//! caller's tolerance, is spent where it buys most per cost, in either part (with two
+//! nested rules and a fixed half each, both parts ended 2–6 times below their shares, at
+//! 1.3–1.5× the time). The azimuths where a beam changes shape (`azimuth_breaks`) are
+//! given to both inner rules as split candidates, not as breaks: a segment the rule would
+//! bisect is cut at the one nearest its middle, so a kink that matters costs one cut and a
+//! weak one nothing (as breaks each cost a 15-node segment, and made the inter-reflections
+//! 4× dearer). The per-segment estimate is the embedded |K15 − G7| rather than QUADPACK's
+//! scaled one, which overstated the error 50–100× here; the footprint crossings are not
+//! given to the rule (located exactly — a degree-2 trigonometric equation per pair of ends
+//! — as split candidates they saved a further 20–25 % of the direct part's evaluations but
+//! cost 6× the time), and the inner bisection floor catches them: against a 1e-7 reference
+//! the estimate was 3.9–59× the actual error at tolerance 1e-4 (the tests below check
+//! pairs).
 //! Grooves steeper than 90° − ψ_min/2 (ψ_min = 4°, i.e. θ_m > 88°) are not followed;
 //! their share of the projected area is measured at construction
 //! ([`VCavityQuadrature::neglected_fraction`]) and is below 1e-6 for Beckmann α ≤ 1.2. The
@@ -106,9 +108,8 @@
 
 use super::vcavity::Orders;
 use crate::fresnel::fresnel_dielectric;
-use crate::math::adaptive_quadrature::{
-    integrate_2d, integrate_2d_with_splits, ErrorEstimate, InnerRange, Tolerance,
-};
+use crate::math::adaptive_quadrature::{integrate_2d, InnerRange, Tolerance};
+use crate::math::nested_quadrature::{NestedIntegrand, NestedQuadrature};
 use crate::math::quadrature::GaussLegendre;
 use crate::math::spectrum::{Spectrum, CHANNELS};
 use crate::math::{Vec3, PI};
@@ -973,54 +974,18 @@ impl VCavityQuadrature {
         2.0 * self.ndf.d(Vec3::new(st * cp, st * sp, ct)) * ct * st
     }
 
-    /// The inter-reflection part of the groove density at (θ_m, φ_m), every channel, with
-    /// the groove weight (remembered per node in `state`).
-    fn galerkin_at(
-        &self,
-        theta: f64,
-        phi: f64,
-        i: Vec3,
-        o: Vec3,
-        state: &mut GalerkinState,
-    ) -> [f64; CHANNELS] {
-        let key = (theta.to_bits(), phi.to_bits());
-        if let Some(v) = state.memo.get(&key) {
-            return *v;
-        }
-        let op = match &state.current {
-            Some((k, op)) if *k == key.0 => op.clone(),
-            _ => {
-                let op = self.operator(theta);
-                state.current = Some((key.0, op.clone()));
-                op
-            }
-        };
-        let azimuth = phi.sin_cos();
-        let weight = self.groove_weight((op.wedge.s, op.wedge.c), azimuth);
-        let mut out = [0.0; CHANNELS];
-        if weight > 0.0 {
-            self.trace_both(&op.wedge, i, o, azimuth, &mut state.scratch);
-            self.galerkin_density(&op, &mut state.scratch, &mut out);
-            out = out.map(|v| weight * v);
-        }
-        state.memo.insert(key, out);
-        out
-    }
-
     /// The multiple-scattering BRDF f_ms(i, o) (orders ≥ 2, or exactly 2) and its estimated
-    /// error, for upper-hemisphere i and o.
+    /// error, for upper-hemisphere i and o; the tolerance is relative to f_ms.
     ///
-    /// p_ms = c_b (⟨E_o, J⁰⟩ + ⟨E_o, 𝒜J⁰⟩) is integrated as two groove-orientation
-    /// integrals [IL18 eq. 23]: the direct part (one body event; grey, no operator, cheap,
-    /// but kinked wherever footprint ends cross, so its rule subdivides a lot) and the
-    /// inter-reflections (smooth in the footprint ends through the C¹ cumulative tables,
-    /// dear per evaluation, few evaluations). Both share one absolute error budget,
-    /// 0.9 · tolerance · f_ms, f_ms estimated by a pilot pass (the first segments of both
-    /// integrals, no bisection): the inter-reflections get half of it and
-    /// the direct part what they leave. Inner integrals then stop at an absolute target, so a
-    /// groove tilt that carries little of f_ms is not integrated to a relative tolerance of
-    /// its own. The reported error is the sum of the two estimates; `converged` says whether
-    /// it is within tolerance · f_ms.
+    /// p_ms = c_b (⟨E_o, J⁰⟩ + ⟨E_o, 𝒜J⁰⟩) is integrated over the groove orientations
+    /// [IL18 eq. 23] as two parts of one [`NestedQuadrature`]: the direct part (one body
+    /// event; no operator, cheap, but kinked wherever footprint ends cross, so its inner
+    /// rules subdivide a lot) and the inter-reflections (smooth in the footprint ends
+    /// through the C¹ cumulative tables, `GALERKIN_COST` (6) times dearer per evaluation, few
+    /// evaluations). Their first segments give a pilot value, from which the absolute error
+    /// budget is set (and reset as the value refines); then the segment that buys most
+    /// error per cost is bisected, of either part, until the summed estimate is within the
+    /// budget. `converged` says whether it is.
     pub fn eval(&self, i: Vec3, o: Vec3) -> MsValue {
         self.eval_in(i, o, Spectrum::ZERO, Spectrum::ZERO)
     }
@@ -1043,143 +1008,36 @@ impl VCavityQuadrature {
                 converged: true,
             };
         }
-        let mut value = Spectrum::ZERO;
-        let mut error = Spectrum::ZERO;
-        let channels = if self.grey() { 1 } else { CHANNELS };
+        let mut density = GrooveDensity::new(self, i, o);
+        let dirac = self.specular_chains(i, o, &mut density.scratch);
         // Fixed first segments (θ nodes then repeat across pairs and hit the cache).
         let breaks = [0.125 * PI, 0.25 * PI, 0.375 * PI];
-        let tol = Tolerance {
-            rel: self.tolerance,
-            abs: 1e-12,
-            max_segments: 200,
-            estimate: ErrorEstimate::Embedded,
-        };
-        // Both parts are cut where a beam changes shape only when a segment there needs
-        // bisecting (see the module notes).
-        let whole_circle = |_| InnerRange {
-            lo: 0.0,
-            hi: PI,
-            breaks: Vec::new(),
-        };
-        let splits = |theta| azimuth_breaks(theta, i, o);
-        let mut scratch = Scratch::default();
-        let dirac = self.specular_chains(i, o, &mut scratch);
-        // The inner rule runs over φ at one θ: its wedge is made once.
-        let mut wedge = (f64::NAN, Wedge::new(0.0));
-        let mut direct_at = |theta: f64, phi: f64| {
-            if theta.to_bits() != wedge.0.to_bits() {
-                wedge = (theta, Wedge::new(theta));
-            }
-            let w = &wedge.1;
-            let azimuth = phi.sin_cos();
-            let weight = self.groove_weight((w.s, w.c), azimuth);
-            if !(weight > 0.0) {
-                return 0.0;
-            }
-            self.trace_both(w, i, o, azimuth, &mut scratch);
-            weight * self.direct_density(&scratch)
-        };
-        // The inter-reflections, all channels at once, remembered per node: the pilot's
-        // nodes are the first nodes of the final pass.
-        let mut state = GalerkinState::default();
-        let mut galerkin_at =
-            |theta: f64, phi: f64, ch: usize| self.galerkin_at(theta, phi, i, o, &mut state)[ch];
-        // Pilot: one pass of the first segments (no bisection) for an
-        // estimate of f_ms that sets the absolute error budget of both parts.
-        let single_pass = Tolerance {
-            max_segments: 1,
-            ..tol
-        };
-        let pilot_direct = integrate_2d(
-            0.0,
-            self.theta_max,
-            &breaks,
-            single_pass,
-            whole_circle,
-            &mut direct_at,
-        );
-        let mut evaluations = pilot_direct.evaluations;
-        // Per channel: the pilot of the inter-reflections sets the budget, of which they get
-        // half (their first nodes are the pilot's, remembered).
-        let mut budget = [0.0; CHANNELS];
-        let mut galerkin = [(0.0, 0.0); CHANNELS];
-        for (ch, (b, gal)) in budget
-            .iter_mut()
-            .zip(&mut galerkin)
-            .enumerate()
-            .take(channels)
-        {
-            let mut galerkin_part = |tol: Tolerance| {
-                integrate_2d_with_splits(
-                    0.0,
-                    self.theta_max,
-                    &breaks,
-                    tol,
-                    whole_circle,
-                    splits,
-                    |t, p| galerkin_at(t, p, ch),
-                )
-            };
-            let pilot = galerkin_part(single_pass);
-            let cb = self.body_factor.0[ch];
-            // 0.9: room for the pilot's own error. `rest` is a BRDF value, the integrals
-            // are f_ms·cos θ_o.
-            let ms = cb * pilot_direct.value + pilot.value + dirac;
-            let budget_in = |c: usize| {
-                (0.9 * self.tolerance * (rest.0[c] * o.z + ms).abs() - rest_error.0[c] * o.z)
-                    .max(0.9 * self.tolerance * ms.abs())
-            };
-            // A grey evaluation stands for every channel: the smallest budget.
-            *b = if channels == 1 {
-                (0..CHANNELS).map(budget_in).fold(f64::INFINITY, f64::min)
-            } else {
-                budget_in(ch)
-            };
-            let q = galerkin_part(Tolerance {
-                rel: 0.0,
-                abs: 0.5 * *b,
-                ..tol
-            });
-            evaluations += q.evaluations;
-            *gal = (q.value, q.error);
-        }
-        if channels == 1 {
-            budget = [budget[0]; CHANNELS];
-            galerkin = [galerkin[0]; CHANNELS];
-        }
-        // The direct part (cheap, kinked) gets what the inter-reflections left, in units of
-        // c_b (it is grey).
-        let direct_budget = (0..CHANNELS)
-            .map(|c| (budget[c] - galerkin[c].1).max(0.0) / self.body_factor.0[c].max(1e-300))
-            .fold(f64::INFINITY, f64::min);
-        let part = Tolerance {
-            rel: 0.0,
-            abs: direct_budget.max(tol.abs),
-            ..tol
-        };
-        let direct = integrate_2d_with_splits(
-            0.0,
-            self.theta_max,
-            &breaks,
-            part,
-            whole_circle,
-            splits,
-            &mut direct_at,
-        );
-        evaluations += direct.evaluations;
+        let mut q = NestedQuadrature::new(0.0, self.theta_max, &breaks, 200, &mut density);
+        // The integrals are f_ms·cos θ_o; `rest` is a BRDF value.
+        let tol = self.tolerance;
+        q.refine(&mut density, |v| {
+            std::array::from_fn(|c| {
+                let ms = v[c] + dirac;
+                (tol * (rest.0[c] * o.z + ms).abs() - rest_error.0[c] * o.z)
+                    .max(tol * ms.abs())
+                    .max(1e-12)
+            })
+        });
+        let (v, e) = (q.value(), q.error());
+        let mut value = Spectrum::ZERO;
+        let mut error = Spectrum::ZERO;
         let mut converged = true;
-        for (c, &(g, eg)) in galerkin.iter().enumerate() {
-            let cb = self.body_factor.0[c];
-            value.0[c] = (cb * direct.value + g + dirac) / o.z;
-            error.0[c] = (cb * direct.error + eg) / o.z;
+        for c in 0..CHANNELS {
+            value.0[c] = (v[c] + dirac) / o.z;
+            error.0[c] = e[c] / o.z;
             converged &=
-                error.0[c] + rest_error.0[c] <= self.tolerance * (rest.0[c] + value.0[c]).abs();
+                error.0[c] + rest_error.0[c] <= tol * (rest.0[c] + value.0[c]).abs() + 1e-12 / o.z;
         }
         MsValue {
             value,
             error,
             specular_chains: dirac / o.z,
-            evaluations,
+            evaluations: q.evaluations(),
             converged,
         }
     }
@@ -1318,12 +1176,112 @@ fn azimuth_breaks(theta: f64, i: Vec3, o: Vec3) -> Vec<f64> {
     out
 }
 
-/// What [`VCavityQuadrature::galerkin_at`] keeps between nodes of one direction pair.
-#[derive(Default)]
-struct GalerkinState {
-    memo: HashMap<(u64, u64), [f64; CHANNELS]>,
-    current: Option<(u64, Arc<GrooveOperator>)>,
+/// Relative price of an inter-reflection evaluation against a direct one (two beams
+/// traced either way; then 4–5 table look-ups per interval end and 21–35 look-ups against
+/// a dozen overlaps): measured 5–7 (α 0.5–1.2, one thread). It steers which part's
+/// segments the quadrature bisects first, not the result.
+const GALERKIN_COST: f64 = 6.0;
+
+/// The groove density at (θ_m, φ_m) for one direction pair, in two parts (see
+/// [`VCavityQuadrature::eval`]): part 0 the direct part c_b⟨E_o, J⁰⟩, part 1 the
+/// inter-reflections ⟨E_o, 𝒜J⁰⟩, both with the groove weight, per channel.
+struct GrooveDensity<'a> {
+    q: &'a VCavityQuadrature,
+    i: Vec3,
+    o: Vec3,
     scratch: Scratch,
+    /// The wedge of the last θ_m of the direct part.
+    wedge: (f64, Wedge),
+    /// The operators of this pair's θ_m nodes (the quadrature moves between nodes; the
+    /// shared cache is behind a lock).
+    operators: HashMap<u64, Arc<GrooveOperator>>,
+    current: Option<(u64, Arc<GrooveOperator>)>,
+}
+
+impl<'a> GrooveDensity<'a> {
+    fn new(q: &'a VCavityQuadrature, i: Vec3, o: Vec3) -> Self {
+        GrooveDensity {
+            q,
+            i,
+            o,
+            scratch: Scratch::default(),
+            wedge: (f64::NAN, Wedge::new(0.0)),
+            operators: HashMap::new(),
+            current: None,
+        }
+    }
+
+    fn operator(&mut self, theta: f64) -> Arc<GrooveOperator> {
+        let key = theta.to_bits();
+        if let Some((k, op)) = &self.current {
+            if *k == key {
+                return op.clone();
+            }
+        }
+        let q = self.q;
+        let op = self
+            .operators
+            .entry(key)
+            .or_insert_with(|| q.operator(theta))
+            .clone();
+        self.current = Some((key, op.clone()));
+        op
+    }
+}
+
+impl NestedIntegrand<CHANNELS> for GrooveDensity<'_> {
+    fn parts(&self) -> usize {
+        2
+    }
+
+    fn cost(&self, part: usize) -> f64 {
+        if part == 0 {
+            1.0
+        } else {
+            GALERKIN_COST
+        }
+    }
+
+    fn inner(&mut self, _: usize, _: f64) -> InnerRange {
+        InnerRange {
+            lo: 0.0,
+            hi: PI,
+            breaks: Vec::new(),
+        }
+    }
+
+    /// Both parts are cut where a beam changes shape only when a segment there needs
+    /// bisecting (see the module notes).
+    fn splits(&mut self, _: usize, theta: f64) -> Vec<f64> {
+        azimuth_breaks(theta, self.i, self.o)
+    }
+
+    fn eval(&mut self, part: usize, theta: f64, phi: f64) -> [f64; CHANNELS] {
+        let q = self.q;
+        let azimuth = phi.sin_cos();
+        if part == 0 {
+            if theta.to_bits() != self.wedge.0.to_bits() {
+                self.wedge = (theta, Wedge::new(theta));
+            }
+            let w = self.wedge.1;
+            let weight = q.groove_weight((w.s, w.c), azimuth);
+            if !(weight > 0.0) {
+                return [0.0; CHANNELS];
+            }
+            q.trace_both(&w, self.i, self.o, azimuth, &mut self.scratch);
+            let d = weight * q.direct_density(&self.scratch);
+            q.body_factor.0.map(|cb| cb * d)
+        } else {
+            let op = self.operator(theta);
+            let weight = q.groove_weight((op.wedge.s, op.wedge.c), azimuth);
+            let mut out = [0.0; CHANNELS];
+            if weight > 0.0 {
+                q.trace_both(&op.wedge, self.i, self.o, azimuth, &mut self.scratch);
+                q.galerkin_density(&op, &mut self.scratch, &mut out);
+            }
+            out.map(|v| weight * v)
+        }
+    }
 }
 
 #[derive(Default)]
