@@ -146,7 +146,8 @@ struct OuterSegment<const C: usize> {
     a: f64,
     b: f64,
     alive: bool,
-    /// At machine resolution: never bisected.
+    /// Never bisected: at machine resolution, or its worst inner segment could not be
+    /// bisected when its inner errors had to come down first (see `INNER_FIRST`).
     frozen: bool,
     nodes: Vec<Node<C>>,
     value: [f64; C],
