@@ -196,7 +196,7 @@ impl<const C: usize> OuterSegment<C> {
     }
 
     fn refresh(&mut self) {
-        let values: Vec<[f64; C]> = self.nodes.iter().map(|n| n.value).collect();
+        let values: [[f64; C]; NODES] = std::array::from_fn(|i| self.nodes[i].value);
         let (c, h) = (0.5 * (self.a + self.b), 0.5 * (self.b - self.a));
         (self.value, self.rule_error) = k15_estimate(c, h, &values);
         self.node_error = [0.0; C];
