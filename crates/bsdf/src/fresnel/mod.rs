@@ -4,11 +4,13 @@
 
 pub mod conductor;
 pub mod dielectric;
+pub mod dielectric_table;
 pub mod diffuse_averages;
 pub mod schlick;
 
 pub use conductor::{fresnel_conductor, MetalPreset};
 pub use dielectric::fresnel_dielectric;
+pub use dielectric_table::FresnelTable;
 pub use diffuse_averages::{external_diffuse_reflectance, internal_diffuse_reflectance};
 pub use schlick::fresnel_schlick;
 

@@ -109,7 +109,7 @@
 //! it with the random walk and check energy conservation).
 
 use super::vcavity::Orders;
-use crate::fresnel::fresnel_dielectric;
+use crate::fresnel::{fresnel_dielectric, FresnelTable};
 use crate::math::adaptive_quadrature::{integrate_2d, InnerRange, Tolerance};
 use crate::math::nested_quadrature::{NestedIntegrand, NestedQuadrature};
 use crate::math::quadrature::GaussLegendre;
@@ -135,6 +135,12 @@ const TABLE_INTERVALS: usize = 128;
 const MAX_BOUNCES: usize = 400;
 /// Most cached groove operators.
 const CACHE_LIMIT: usize = 8192;
+/// The beam tracer's Fresnel table is used where its error (absolute, on F) is at most this
+/// share of the relative tolerance (an error δ on one F moves a path's weight by at most δ
+/// times the product of its other factors); else the formula. The formula was an eighth
+/// of IL_∞'s `eval`; with the table `eval` does 1.05× (Beckmann α 0.5) and 1.10× (α 1.2)
+/// the pairs per second at 1e-4.
+const FRESNEL_SHARE: f64 = 1e-3;
 
 #[inline]
 fn cross(a: (f64, f64), b: (f64, f64)) -> f64 {
@@ -235,8 +241,14 @@ struct Exit {
 
 /// Traces collimated light entering the opening with propagation direction `d` (2-D
 /// projection, d.1 < 0): every footprint and every exit, with the specular branch of each
-/// footprint followed (probability F).
-fn trace_beam(w: &Wedge, d: (f64, f64), ni: f64, hits: &mut Vec<Hit>, exits: &mut Vec<Exit>) {
+/// footprint followed (probability F, from `fresnel`).
+fn trace_beam(
+    w: &Wedge,
+    d: (f64, f64),
+    fresnel: &FresnelTable,
+    hits: &mut Vec<Hit>,
+    exits: &mut Vec<Exit>,
+) {
     hits.clear();
     exits.clear();
     if !(d.1 < 0.0) {
@@ -269,7 +281,7 @@ fn trace_beam(w: &Wedge, d: (f64, f64), ni: f64, hits: &mut Vec<Hit>, exits: &mu
                 power: 0.5 * (xb - xa),
                 fres: 1.0,
                 cos,
-                f: fresnel_dielectric(cos, ni),
+                f: fresnel.eval(cos),
                 bounces: 0,
                 first: k,
                 d,
@@ -323,7 +335,7 @@ fn trace_beam(w: &Wedge, d: (f64, f64), ni: f64, hits: &mut Vec<Hit>, exits: &mu
                 power: power * frac,
                 fres,
                 cos: cos2,
-                f: fresnel_dielectric(cos2, ni),
+                f: fresnel.eval(cos2),
                 bounces: h.bounces + 1,
                 first: h.first,
                 d: d2,
@@ -722,6 +734,9 @@ pub struct VCavityQuadrature {
     theta_max: f64,
     neglected: f64,
     resolution: (usize, usize),
+    /// F(·, n_i) of the beam tracer, tabulated where its error is below `FRESNEL_SHARE` of
+    /// the tolerance.
+    fresnel: FresnelTable,
     cache: Mutex<HashMap<u64, Arc<GrooveOperator>>>,
 }
 
@@ -784,6 +799,7 @@ impl VCavityQuadrature {
             theta_max,
             neglected,
             resolution: (CELLS, CELL_GL),
+            fresnel: FresnelTable::with_accuracy(ni, FRESNEL_SHARE * tolerance),
             cache: Mutex::new(HashMap::new()),
         }
     }
@@ -808,6 +824,7 @@ impl VCavityQuadrature {
             theta_max: self.theta_max,
             neglected: self.neglected,
             resolution: (CELLS, CELL_GL),
+            fresnel: self.fresnel.clone(),
             cache: Mutex::new(HashMap::new()),
         }
         .with_resolution(cells, cell_gl)
@@ -857,8 +874,8 @@ impl VCavityQuadrature {
     fn trace_both(&self, w: &Wedge, i: Vec3, o: Vec3, (sp, cp): (f64, f64), scratch: &mut Scratch) {
         let di = (-(i.x * cp + i.y * sp), -i.z);
         let dout = (-(o.x * cp + o.y * sp), -o.z);
-        trace_beam(w, di, self.ni, &mut scratch.ih, &mut scratch.ie);
-        trace_beam(w, dout, self.ni, &mut scratch.oh, &mut scratch.oe);
+        trace_beam(w, di, &self.fresnel, &mut scratch.ih, &mut scratch.ie);
+        trace_beam(w, dout, &self.fresnel, &mut scratch.oh, &mut scratch.oe);
     }
 
     /// The direct part of p_ms(o | i, m), ⟨E_o, J⁰⟩/c_b: one body event, at a point where
@@ -1093,7 +1110,7 @@ impl VCavityQuadrature {
                         continue; // more bounces than a groove this wide allows
                     }
                     let di = (-(i.x * cp + i.y * sp), -i.z);
-                    trace_beam(&w, di, self.ni, &mut scratch.ih, &mut scratch.ie);
+                    trace_beam(&w, di, &self.fresnel, &mut scratch.ih, &mut scratch.ie);
                     let power: f64 = scratch
                         .ie
                         .iter()
@@ -1326,6 +1343,8 @@ mod tests {
     fn beams_conserve_energy_with_white_facets() {
         // Every footprint's power either reflects (F) or enters the body (1 − F): the exits
         // plus the body shares add to the power that entered.
+        let fresnel = FresnelTable::with_accuracy(1.5, 1e-12);
+        assert!(fresnel.is_tabulated());
         for theta in [0.2, 0.7, 1.1, 1.4] {
             let w = Wedge::new(theta);
             for a in [-1.2f64, -0.6, -0.1, 0.4, 1.3] {
@@ -1333,10 +1352,10 @@ mod tests {
                 let l = (d.0 * d.0 + d.1 * d.1).sqrt();
                 let d = (d.0 / l * 0.95, d.1 / l * 0.95);
                 let (mut hits, mut exits) = (Vec::new(), Vec::new());
-                trace_beam(&w, d, 1.5, &mut hits, &mut exits);
+                trace_beam(&w, d, &fresnel, &mut hits, &mut exits);
                 let body: f64 = hits
                     .iter()
-                    .map(|h| h.power * (1.0 - fresnel_dielectric(h.cos, 1.5)))
+                    .map(|h| h.power * (1.0 - fresnel.eval(h.cos)))
                     .sum();
                 let out: f64 = exits.iter().map(|x| x.power).sum();
                 assert!(
