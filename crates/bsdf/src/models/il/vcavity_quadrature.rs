@@ -109,6 +109,7 @@
 //! it with the random walk and check energy conservation).
 
 use super::vcavity::Orders;
+use crate::fresnel::dielectric_table::lagrange4;
 use crate::fresnel::{fresnel_dielectric, FresnelTable};
 use crate::math::adaptive_quadrature::{integrate_2d, InnerRange, Tolerance};
 use crate::math::nested_quadrature::{NestedIntegrand, NestedQuadrature};
@@ -415,14 +416,9 @@ impl ChainTable {
         let x = ((omega - self.delta) / self.step).clamp(0.0, TABLE_INTERVALS as f64);
         let n = (x.floor() as usize).clamp(1, TABLE_INTERVALS - 2);
         let t = x - n as f64;
-        let v = &self.values;
-        let (p0, p1, p2, p3) = (v[n - 1], v[n], v[n + 1], v[n + 2]);
         // Cubic Lagrange through nodes n−1 … n+2 (t measured from node n).
-        let a = -t * (t - 1.0) * (t - 2.0) / 6.0;
-        let b = (t + 1.0) * (t - 1.0) * (t - 2.0) / 2.0;
-        let c = -(t + 1.0) * t * (t - 2.0) / 2.0;
-        let d = (t + 1.0) * t * (t - 1.0) / 6.0;
-        a * p0 + b * p1 + c * p2 + d * p3
+        let p = &self.values[n - 1..n + 3];
+        lagrange4(t, [p[0], p[1], p[2], p[3]])
     }
 
     /// K_j(u, u')/c_b, zero when the chain leaves the groove (crosses an image facet
