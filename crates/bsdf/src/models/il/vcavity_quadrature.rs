@@ -1402,37 +1402,58 @@ mod tests {
 
     #[test]
     fn a_bump_between_the_first_nodes_is_not_missed() {
-        // Beckmann α 1.2, K_d 0.8, n_i 1.5, i at 79.5°: over θ_m ∈ [0.53, 0.58] the direct
-        // part has two bumps in φ_m ∈ (1.26, 1.9) that fall between the nodes of a single
-        // 15-node rule on [0, π) (see `DIRECT_START`); the value at 1e-4 and 1e-5 (relative
-        // to f₁ + f_ms, f₁ = 0.1765 there) against 1e-6 must be within the reported error.
+        // K_d 0.8, n_i 1.5, grazing pairs where the direct part has bumps in φ_m that fall
+        // between the nodes of a single 15-node rule on [0, π) (see `DIRECT_START`): Beckmann
+        // α 1.2, i at 79.5° (bumps in φ_m ∈ (1.26, 1.9) over θ_m ∈ [0.53, 0.58]; the actual
+        // error was 2.3× the reported at 1e-4 and 18× at 1e-5), and α 0.5, i at 77.9°, o at
+        // 80.2° (off by 22× the tolerance at 1e-4). The value at 1e-4 and 1e-5, relative to
+        // f₁ + f_ms (f₁ given), must be within the reported error of a tight reference: 1e-6
+        // at α 1.2 (within 9e-9 of 1e-7 there), 1e-7 at α 0.5, where the 1e-6 value is itself
+        // off by 7.0e-7, 11× its estimate (a limit of the estimate left open).
         use crate::math::spherical_direction;
         use crate::microfacet::Beckmann;
         let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
         let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri)[0];
-        let q = |tol| {
-            VCavityQuadrature::new(
-                Ndf::Beckmann(Beckmann::isotropic(1.2).unwrap()),
-                1.5,
-                Spectrum::splat(cb),
-                Orders::SecondAndHigher,
-                tol,
-            )
-        };
-        let i = spherical_direction(1.386_949, 0.007_722);
-        let o = spherical_direction(0.511_442, 0.731_228);
-        let rest = Spectrum::splat(0.176_476_74);
-        let reference = q(1e-6).eval_in(i, o, rest, Spectrum::ZERO);
-        for tol in [1e-4, 1e-5] {
-            let v = q(tol).eval_in(i, o, rest, Spectrum::ZERO);
-            let actual = (v.value[1] - reference.value[1]).abs();
-            let line = format!(
-                "tol {tol}: {} ± {:.2e} vs reference {} ± {:.2e} (actual {actual:.2e})",
-                v.value[1], v.error[1], reference.value[1], reference.error[1]
-            );
-            assert!(v.converged && reference.converged, "{line}");
-            assert!(actual <= v.error[1] + reference.error[1], "{line}");
-            println!("{line}");
+        let cases = [
+            (
+                1.2,
+                (1.386_949, 0.007_722),
+                (0.511_442, 0.731_228),
+                0.176_476_74,
+                1e-6,
+            ),
+            (
+                0.5,
+                (1.359_594, 3.983_417),
+                (1.399_335, 0.152_402),
+                0.050_113_03,
+                1e-7,
+            ),
+        ];
+        for (alpha, (ti, pi), (to, po), f1, tight) in cases {
+            let q = |tol| {
+                VCavityQuadrature::new(
+                    Ndf::Beckmann(Beckmann::isotropic(alpha).unwrap()),
+                    1.5,
+                    Spectrum::splat(cb),
+                    Orders::SecondAndHigher,
+                    tol,
+                )
+            };
+            let (i, o) = (spherical_direction(ti, pi), spherical_direction(to, po));
+            let rest = Spectrum::splat(f1);
+            let reference = q(tight).eval_in(i, o, rest, Spectrum::ZERO);
+            for tol in [1e-4, 1e-5] {
+                let v = q(tol).eval_in(i, o, rest, Spectrum::ZERO);
+                let actual = (v.value[1] - reference.value[1]).abs();
+                let line = format!(
+                    "α {alpha} tol {tol}: {} ± {:.2e} vs reference {} ± {:.2e} (actual {actual:.2e})",
+                    v.value[1], v.error[1], reference.value[1], reference.error[1]
+                );
+                assert!(v.converged && reference.converged, "{line}");
+                assert!(actual <= v.error[1] + reference.error[1], "{line}");
+                println!("{line}");
+            }
         }
     }
 
