@@ -139,8 +139,9 @@ const CACHE_LIMIT: usize = 8192;
 /// The beam tracer's Fresnel table is used where its error (absolute, on F) is at most this
 /// share of the relative tolerance (an error δ on one F moves a path's weight by at most δ
 /// times the product of its other factors); else the formula. The formula was an eighth
-/// of IL_∞'s `eval`; with the table `eval` does 1.05× (Beckmann α 0.5) and 1.10× (α 1.2)
-/// the pairs per second at 1e-4.
+/// of IL_∞'s `eval` in the profile; a timing probe gave 1.05× (Beckmann α 0.5) and 1.10×
+/// (α 1.2) the pairs per second with the table, within the shared machine's noise
+/// (docs/performance.md).
 const FRESNEL_SHARE: f64 = 1e-3;
 
 #[inline]
