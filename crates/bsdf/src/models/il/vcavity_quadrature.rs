@@ -1363,6 +1363,19 @@ mod tests {
         }
     }
 
+    /// IL_∞ by quadrature with K_d 0.8, n_i 1.5 (the tests' material) at `tolerance`.
+    fn il_infinity(ndf: crate::microfacet::Beckmann, tolerance: f64) -> VCavityQuadrature {
+        let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
+        let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri);
+        VCavityQuadrature::new(
+            Ndf::Beckmann(ndf),
+            1.5,
+            cb,
+            Orders::SecondAndHigher,
+            tolerance,
+        )
+    }
+
     #[test]
     fn the_reported_error_bounds_the_error_against_a_tight_reference() {
         // IL_∞ (K_d 0.8, n_i 1.5) at tolerances 1e-3 and 1e-4 against the same quadrature at
@@ -1372,18 +1385,8 @@ mod tests {
         // against 2.9e-6 at 1e-3 when measured).
         use crate::math::spherical_direction;
         use crate::microfacet::Beckmann;
-        let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
-        let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri)[0];
         for (alpha, (to, ti, pi)) in [(0.5, (0.2, 1.0, 1.0)), (1.2, (0.9, 1.2, 0.5))] {
-            let q = |tol| {
-                VCavityQuadrature::new(
-                    Ndf::Beckmann(Beckmann::isotropic(alpha).unwrap()),
-                    1.5,
-                    Spectrum::splat(cb),
-                    Orders::SecondAndHigher,
-                    tol,
-                )
-            };
+            let q = |tol| il_infinity(Beckmann::isotropic(alpha).unwrap(), tol);
             let (o, i) = (spherical_direction(to, 0.0), spherical_direction(ti, pi));
             let reference = q(1e-6).eval(i, o);
             for tol in [1e-3, 1e-4] {
@@ -1413,8 +1416,6 @@ mod tests {
         // off by 7.0e-7, 11× its estimate (a limit of the estimate left open).
         use crate::math::spherical_direction;
         use crate::microfacet::Beckmann;
-        let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
-        let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri)[0];
         let cases = [
             (
                 1.2,
@@ -1432,15 +1433,7 @@ mod tests {
             ),
         ];
         for (alpha, (ti, pi), (to, po), f1, tight) in cases {
-            let q = |tol| {
-                VCavityQuadrature::new(
-                    Ndf::Beckmann(Beckmann::isotropic(alpha).unwrap()),
-                    1.5,
-                    Spectrum::splat(cb),
-                    Orders::SecondAndHigher,
-                    tol,
-                )
-            };
+            let q = |tol| il_infinity(Beckmann::isotropic(alpha).unwrap(), tol);
             let (i, o) = (spherical_direction(ti, pi), spherical_direction(to, po));
             let rest = Spectrum::splat(f1);
             let reference = q(tight).eval_in(i, o, rest, Spectrum::ZERO);
@@ -1467,17 +1460,7 @@ mod tests {
         // groove densities are evaluated than for the same tolerance relative to f_ms alone.
         use crate::math::spherical_direction;
         use crate::microfacet::Beckmann;
-        let ri = crate::fresnel::diffuse_averages::internal_diffuse_reflectance(1.5);
-        let cb = super::super::interfaced_lambertian::body_factor(Spectrum::splat(0.8), 1.5, ri)[0];
-        let q = |tol| {
-            VCavityQuadrature::new(
-                Ndf::Beckmann(Beckmann::isotropic(0.5).unwrap()),
-                1.5,
-                Spectrum::splat(cb),
-                Orders::SecondAndHigher,
-                tol,
-            )
-        };
+        let q = |tol| il_infinity(Beckmann::isotropic(0.5).unwrap(), tol);
         let (tight, tol) = (q(1e-7), 1e-4);
         let quadrature = q(tol);
         for (to, ti, pi) in [(0.9, 1.2, 0.5), (1.1, 0.7, 3.0)] {
