@@ -29,6 +29,7 @@
 
 use crate::geometry::{HitDetail, Ray, RayDifferential, SurfaceHit, Vec3};
 use crate::lights::Light;
+use crate::pixel_footprint::{pixel_shading, PixelRay};
 use crate::sampler::{PrefixedSource, SampleStream};
 use crate::scene::Scene;
 use facette_bsdf::{BsdfContext, LobeFlags, Spectrum};
@@ -66,6 +67,7 @@ pub fn radiance(
     scene: &Scene,
     ray: Ray,
     rd: Option<RayDifferential>,
+    pixel: Option<PixelRay>,
     sampler: &mut SampleStream,
     strategy: Strategy,
 ) -> Spectrum {
@@ -125,16 +127,25 @@ pub fn radiance(
         }
         let material = &scene.materials[scene.shape_material[hit.shape as usize] as usize];
         let mut derivs = [0.0; 4];
+        // The pixel's footprint replaces the hit's uv, derivatives and frame (glints with
+        // `footprint = "pixel"` at a camera ray's hit).
+        let mut centre = None;
         if material.reads_surface_details() {
             scene.geometry.complete_hit(&mut hit);
             if let (Some(d), 1) = (&rd, segment) {
                 derivs = hit.uv_derivatives(d);
+                centre = pixel
+                    .filter(|_| material.reads_pixel_footprint())
+                    .and_then(|p| pixel_shading(scene, &hit, ray.dir, &p));
             }
         }
-        let Some(bsdf) = material.bsdf(hit.uv, derivs) else {
+        let (uv, derivs, frame) = match centre {
+            Some(c) => (c.uv, c.derivs, c.frame),
+            None => (hit.uv, derivs, hit.shading_frame()),
+        };
+        let Some(bsdf) = material.bsdf(uv, derivs) else {
             break;
         };
-        let frame = hit.shading_frame();
         let wo = frame.to_local(-ray.dir);
         let flags = bsdf.flags();
         // This vertex's block of dimensions; a decision that is not taken (no light

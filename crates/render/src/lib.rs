@@ -12,6 +12,7 @@
 //! - [`integrator`]: the path tracer (NEE + MIS, Russian roulette).
 //! - [`sampler`]: the pixel samplers (Owen-scrambled Sobol in Morton order, stratified,
 //!   independent) that give each camera sample its random numbers.
+//! - [`pixel_footprint`]: the whole pixel's footprint at a camera ray's hit (glints).
 //! - [`render`]: tiles in parallel, passes, interruption, determinism.
 //! - [`partial_film`]: parts of a render for distributed runs, saved exactly and merged.
 
@@ -27,6 +28,7 @@ pub mod kernel;
 pub mod lights;
 pub mod materials;
 pub mod partial_film;
+pub mod pixel_footprint;
 pub mod render;
 pub mod sampler;
 pub mod scene;

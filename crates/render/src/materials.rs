@@ -293,6 +293,13 @@ impl SceneMaterial {
         self.fixed.is_none()
     }
 
+    /// Whether a camera ray's first hit on this material shades with the pixel's footprint
+    /// ([`crate::pixel_footprint`]: glints with `footprint = "pixel"`).
+    #[inline]
+    pub fn reads_pixel_footprint(&self) -> bool {
+        self.recipe.reads_pixel_footprint()
+    }
+
     /// The BSDF at a shading point with texture coordinates `uv` and footprint `derivs`
     /// (`[du/dx, dv/dx, du/dy, dv/dy]`, zeros when unknown): the shared one for an
     /// untextured material (borrowed: no reference-count traffic between threads), a

@@ -9,6 +9,7 @@ use crate::film::Film;
 use crate::geometry::{Ray, RayDifferential, Vec2};
 use crate::integrator::{radiance, Strategy};
 use crate::kernel::{packet, Kernel};
+use crate::pixel_footprint::PixelRay;
 use crate::sampler::{PixelSampler, SampleStream, SamplerKind};
 use crate::scene::Scene;
 use facette_bsdf::Spectrum;
@@ -145,11 +146,15 @@ pub(crate) struct CameraSampling {
     pub footprints: bool,
     /// The differentials' scale for the pixel's sample count.
     pub diff_scale: f64,
+    /// Whether some material shades a camera ray's hit with the pixel's footprint (then
+    /// each camera sample carries its pixel's centre ray, [`PixelRay`]).
+    pub pixel_footprints: bool,
 }
 
 impl CameraSampling {
     /// The camera ray of pixel (x, y) from the stream's first dimensions: the filter
-    /// offset (2), then the lens position (2).
+    /// offset (2), then the lens position (2); its differentials and its pixel's centre ray
+    /// where materials read them.
     #[inline]
     pub(crate) fn ray(
         &self,
@@ -157,16 +162,19 @@ impl CameraSampling {
         stream: &mut SampleStream,
         x: usize,
         y: usize,
-    ) -> (Ray, Option<RayDifferential>) {
+    ) -> (Ray, Option<RayDifferential>, Option<PixelRay>) {
         let off = scene.film.filter.sample(stream.get_2d());
         let (fx, fy) = (x as f64 + 0.5 + off.x, y as f64 + 0.5 + off.y);
         let lens = stream.get_2d_where(scene.camera.has_lens());
         let lens = Vec2::new(lens.x, lens.y);
         if self.footprints {
             let (ray, rd) = scene.camera.generate_ray(fx, fy, lens);
-            (ray, Some(rd.scaled(&ray, self.diff_scale)))
+            let pixel = self
+                .pixel_footprints
+                .then(|| PixelRay::new(&scene.camera, x as u32, y as u32, lens));
+            (ray, Some(rd.scaled(&ray, self.diff_scale)), pixel)
         } else {
-            (scene.camera.generate_primary_ray(fx, fy, lens), None)
+            (scene.camera.generate_primary_ray(fx, fy, lens), None, None)
         }
     }
 }
@@ -244,6 +252,7 @@ fn render_in_pool(
         diff_scale: 1.0 / (spp as f64).sqrt().max(1.0),
         // Ray differentials only serve texture and glint footprints.
         footprints: scene.materials.iter().any(|m| m.reads_surface_details()),
+        pixel_footprints: scene.materials.iter().any(|m| m.reads_pixel_footprint()),
     };
     let kernel = opts
         .kernel
@@ -288,8 +297,15 @@ fn render_in_pool(
                                 let p = &mut out[(y - y0) * (x1 - x0) + x - x0];
                                 for &s in chunk {
                                     let mut stream = sampler.stream(x, y, s as u64);
-                                    let (ray, rd) = cameras.ray(scene, &mut stream, x, y);
-                                    p.add(radiance(scene, ray, rd, &mut stream, opts.strategy));
+                                    let (ray, rd, pixel) = cameras.ray(scene, &mut stream, x, y);
+                                    p.add(radiance(
+                                        scene,
+                                        ray,
+                                        rd,
+                                        pixel,
+                                        &mut stream,
+                                        opts.strategy,
+                                    ));
                                 }
                             }
                             let row = ((x1 - x0) * chunk.len()) as u64;

@@ -1040,6 +1040,12 @@ const GLINT: &[Param] = &[
         "\"patch\"",
         "the footprint's P-BRDF, or the brute-force reference",
     ),
+    choice(
+        "footprint",
+        &["ray", "pixel"],
+        "\"ray\"",
+        "at a camera ray's hit: the sample's own ray footprint, or the whole pixel's (in the frame of the pixel's centre)",
+    ),
     Param::new(
         "footprint_center",
         ParamKind::Numbers {

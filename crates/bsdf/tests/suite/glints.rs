@@ -568,3 +568,28 @@ fn the_reference_evaluation_is_the_interpolated_map_at_the_hit() {
     );
     assert!(peak[0] > 1.0 && off[0] < 1e-6 * peak[0], "{peak:?} {off:?}");
 }
+
+/// `footprint` chooses what a renderer passes at a camera ray's hit: `ray` by default,
+/// `pixel` on request (not for the brute-force reference, which has no footprint); any
+/// other value is an error that lists both.
+#[test]
+fn the_footprint_key_takes_ray_or_pixel() {
+    let recipe = |extra: &str| {
+        let s = format!("{{type = \"glint\", generate = \"bumpy\", resolution = 16{extra}}}");
+        MaterialRecipe::parse(&parse_inline_table(&s).unwrap(), std::path::Path::new("."))
+    };
+    assert!(!recipe("").unwrap().reads_pixel_footprint());
+    assert!(!recipe(", footprint = \"ray\"")
+        .unwrap()
+        .reads_pixel_footprint());
+    assert!(recipe(", footprint = \"pixel\"")
+        .unwrap()
+        .reads_pixel_footprint());
+    assert!(
+        !recipe(", footprint = \"pixel\", evaluation = \"reference\"")
+            .unwrap()
+            .reads_pixel_footprint()
+    );
+    let e = recipe(", footprint = \"wide\"").unwrap_err().to_string();
+    assert!(e.contains("wide") && e.contains("ray, pixel"), "{e}");
+}

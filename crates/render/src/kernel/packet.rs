@@ -46,6 +46,7 @@ use crate::image::ConstantEnvironment;
 use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
 use crate::lights::{Environment, Light};
 use crate::materials::{LaneTexel, MaterialBsdf, SceneMaterial};
+use crate::pixel_footprint::{pixel_shading, PixelRay};
 use crate::render::{CameraSampling, PixelSums};
 use crate::sampler::lanes::{move_lanes, SampleLanes};
 use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
@@ -55,6 +56,7 @@ use facette_bsdf::lanes::F32x8Avx2;
 use facette_bsdf::lanes::{channels, Bits32, F32x8, LFrame, LVec3, Mask, Real};
 use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
+use facette_bsdf::math::Frame;
 use facette_bsdf::models::{LaneBsdf, LaneColors, LaneRandom, OwnColors};
 use facette_bsdf::{BsdfContext, LobeFlags, Spectrum};
 use std::ops::Range;
@@ -130,6 +132,8 @@ struct Paths<S: ShadingLanes, G: Real> {
     d: LVec3<G>,
     /// The camera ray's differentials (only where materials read footprints).
     rd: [Option<RayDifferential>; LANES],
+    /// The camera ray's pixel centre ray (only where materials read pixel footprints).
+    pixel: [Option<PixelRay>; LANES],
     l: Rgb<S>,
     beta: Rgb<S>,
     delta_prev: Lanes,
@@ -179,6 +183,7 @@ struct CameraBatch<G: Real> {
     o: LVec3<G>,
     d: LVec3<G>,
     rd: [Option<RayDifferential>; LANES],
+    pixel: [Option<PixelRay>; LANES],
 }
 
 /// Each lane's [`SampleStream`], made at its first use from the lane's camera sample: a lane
@@ -415,6 +420,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         o: LVec3::zero(),
         d: LVec3::zero(),
         rd: [None; LANES],
+        pixel: [None; LANES],
     };
     let mut segment = SegmentHits::default();
     let mut paths = Paths::<S, G> {
@@ -425,6 +431,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         o: LVec3::zero(),
         d: LVec3::zero(),
         rd: [None; LANES],
+        pixel: [None; LANES],
         l: [S::zero(); 3],
         beta: [S::one(); 3],
         delta_prev: 0,
@@ -583,6 +590,7 @@ impl<'s> Kernel<'s> {
                 set |= 1 << i;
                 if self.cameras.footprints {
                     paths.rd[i] = batch.rd[j];
+                    paths.pixel[i] = batch.pixel[j];
                 }
             }
             let taken = ((1u32 << batch.next) - (1u32 << first)) as Lanes;
@@ -667,10 +675,15 @@ impl<'s> Kernel<'s> {
                 batch.o.set_lane(i, ray.origin);
                 batch.d.set_lane(i, ray.dir);
                 batch.rd[i] = Some(rd.scaled(&ray, self.cameras.diff_scale));
+                batch.pixel[i] = self
+                    .cameras
+                    .pixel_footprints
+                    .then(|| PixelRay::new(&scene.camera, xs[i], ys[i], lens));
             }
         } else {
             (batch.o, batch.d) = scene.camera.primary_rays(fx, fy, lens);
             batch.rd = [None; LANES];
+            batch.pixel = [None; LANES];
         }
         true
     }
@@ -773,6 +786,9 @@ impl<'s> Kernel<'s> {
         let mut first_model: Option<&LaneBsdf> = None;
         let mut smooth: Lanes = 0;
         let mut no_bsdf: Lanes = 0;
+        // Lanes that shade in their pixel centre's frame (pixel footprints).
+        let mut reframed: Lanes = 0;
+        let mut centre_frames: [Option<Frame>; LANES] = [None; LANES];
         // Most vertices' lanes share one untextured lane material (a single object, or
         // paths in step): its lanes are set at once.
         let live = paths.live;
@@ -801,7 +817,7 @@ impl<'s> Kernel<'s> {
             vertex.bsdfs[i] = match m.lane_bsdf() {
                 Some(lane) => {
                     let bsdf = if m.is_textured() {
-                        let (uv, derivs) = self.surface_details(paths, hl, m, i);
+                        let (uv, derivs, _) = self.surface_details(paths, hl, m, i);
                         match m.lane_texel(uv, derivs) {
                             Some(LaneTexel::Colors(c)) => {
                                 vertex.texels.colors[i] = c;
@@ -832,7 +848,11 @@ impl<'s> Kernel<'s> {
                     bsdf
                 }
                 None => {
-                    let (uv, derivs) = self.surface_details(paths, hl, m, i);
+                    let (uv, derivs, frame) = self.surface_details(paths, hl, m, i);
+                    if let Some(f) = frame {
+                        centre_frames[i] = Some(f);
+                        reframed |= 1 << i;
+                    }
                     match m.bsdf(uv, derivs) {
                         Some(b) => {
                             if b.flags().has_smooth_part() {
@@ -855,7 +875,14 @@ impl<'s> Kernel<'s> {
         vertex.one_lane_model = one_lane_model;
         vertex.textured = textured;
         let vertex = &segment.vertex;
-        let frame = LFrame::from_normal_tangent(hl.ns, hl.dpdu);
+        let mut frame = LFrame::from_normal_tangent(hl.ns, hl.dpdu);
+        for i in lanes_of(reframed & paths.live) {
+            if let Some(f) = centre_frames[i] {
+                frame.s.set_lane(i, f.s);
+                frame.t.set_lane(i, f.t);
+                frame.n.set_lane(i, f.n);
+            }
+        }
         let wo = conv_vec::<G, S>(frame.to_local(-paths.d));
         if self.strategy != Strategy::BsdfOnly {
             let set = smooth & paths.live;
@@ -928,7 +955,9 @@ impl<'s> Kernel<'s> {
     }
 
     /// Lane `i`'s texture coordinates and footprint where its material `m` reads them (what
-    /// the scalar integrator computes at the same hit), zeros otherwise.
+    /// the scalar integrator computes at the same hit), zeros otherwise; and, where `m`
+    /// shades a camera ray's hit with its pixel's footprint, the pixel centre's shading
+    /// frame, which the lane shades in ([`crate::pixel_footprint`]).
     #[inline(always)]
     fn surface_details<S: ShadingLanes, G: Real>(
         &self,
@@ -936,16 +965,22 @@ impl<'s> Kernel<'s> {
         hl: &HitLanes<G>,
         m: &SceneMaterial,
         i: usize,
-    ) -> (crate::geometry::Vec2, [f64; 4]) {
+    ) -> (crate::geometry::Vec2, [f64; 4], Option<Frame>) {
         let mut hit = hl.surface_hit(i);
         let mut derivs = [0.0; 4];
         if m.reads_surface_details() {
             self.scene.geometry.complete_hit(&mut hit);
             if let (Some(d), 1) = (&paths.rd[i], paths.segment.lane(i)) {
                 derivs = hit.uv_derivatives(d);
+                let centre = paths.pixel[i]
+                    .filter(|_| m.reads_pixel_footprint())
+                    .and_then(|p| pixel_shading(self.scene, &hit, paths.d.lane(i), &p));
+                if let Some(c) = centre {
+                    return (c.uv, c.derivs, Some(c.frame));
+                }
             }
         }
-        (hit.uv, derivs)
+        (hit.uv, derivs, None)
     }
 
     /// Emission seen by the rays of `missed` leaving the scene.
@@ -1527,6 +1562,7 @@ mod tests {
             cameras: CameraSampling {
                 footprints: false,
                 diff_scale: 1.0,
+                pixel_footprints: false,
             },
             strategy,
             xs: 0..scene.film.width,
@@ -1556,6 +1592,7 @@ mod tests {
         let cameras = CameraSampling {
             footprints: false,
             diff_scale: 1.0,
+            pixel_footprints: false,
         };
         let chunk: Vec<u32> = (0..8).collect();
         let never = || false;
@@ -1577,8 +1614,8 @@ mod tests {
                         let mut scalar = PixelSums::default();
                         for &s in &chunk {
                             let mut stream = sampler.stream(x, y, s as u64);
-                            let (ray, rd) = cameras.ray(&scene, &mut stream, x, y);
-                            scalar.add(radiance(&scene, ray, rd, &mut stream, strategy));
+                            let (ray, rd, pixel) = cameras.ray(&scene, &mut stream, x, y);
+                            scalar.add(radiance(&scene, ray, rd, pixel, &mut stream, strategy));
                         }
                         let (a, b) = (scalar.sums(), lanes[y * w + x].sums());
                         for c in 0..3 {
@@ -1707,6 +1744,7 @@ mod tests {
             cameras: CameraSampling {
                 footprints: false,
                 diff_scale: 1.0,
+                pixel_footprints: false,
             },
             strategy: Strategy::Mis,
             xs: 2..10,

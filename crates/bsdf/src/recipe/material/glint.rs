@@ -18,6 +18,7 @@
 //! | `masking` | `exact` (eqs. 10–17) or `approx` (§4.2.2) | — | `exact` |
 //! | `evaluation` | `patch` (the P-BRDF of the footprint) or `reference` (brute force: the map at the shading point's uv as a σ_ε surface, no footprint; converges with samples per pixel) | — | `patch` |
 //! | `masking_lobes` | budget of the exact masking sum (0: unlimited) | ≥ 0 | 1024 |
+//! | `footprint` | at a camera ray's hit, `ray` (the sample's own ray-differential footprint, scaled by 1/√spp) or `pixel` (the footprint of the whole pixel under the reconstruction filter, in the shading frame of the pixel's centre: every sample of a pixel shades the same patch, so the glints are converged at a few samples per pixel, at 2.8× the cost of a sample; docs/glints.md) | — | `ray` |
 //! | `footprint_center` | footprint centre in uv when none is given by a renderer | any | [0.5, 0.5] |
 //! | `footprint_size` | footprint standard deviation in texels: σ, [σ_u, σ_v] or [σ_u, σ_v, ρ] | σ ≥ 0, ρ ∈ (−1, 1) | 2 |
 //! | `material`, `eta`, `k`, `fresnel` | conductor Fresnel term, as for `conductor` | | F = 1 |
@@ -30,9 +31,14 @@
 //!
 //! **Footprints.** A renderer passes the shading point's uv and screen-space derivatives
 //! ([`GlintRecipe::footprint_at`]): the footprint is the Gaussian of covariance
-//! s²(d_x d_xᵀ + d_y d_yᵀ) with d_x, d_y the texel offsets of one (scaled) pixel step and
-//! s = [`PIXEL_FOOTPRINT_SIGMA`]. Without derivatives (secondary hits, `facette eval`) it
-//! uses `footprint_size` around the given uv (or `footprint_center`).
+//! s²(d_x d_xᵀ + d_y d_yᵀ) with d_x, d_y the texel offsets of one pixel step and
+//! s = [`PIXEL_FOOTPRINT_SIGMA`]. With `footprint = "ray"` (the default) they are the
+//! sample's own uv and its differentials scaled by 1/√spp; with `"pixel"` the renderer
+//! passes, at a camera ray's first hit, the uv and the unscaled derivatives of the pixel's
+//! centre, scaled so that s d matches the reconstruction filter's standard deviation, and
+//! shades in the frame of the centre's hit (`facette_render::pixel_footprint`). Without derivatives
+//! (secondary hits, `facette eval`) it uses `footprint_size` around the given uv (or
+//! `footprint_center`).
 
 use crate::bsdf::Bsdf;
 use crate::checks::{check_range, check_reflectance, Bounds};
@@ -62,6 +68,7 @@ pub const GLINT_KEYS: &[&str] = &[
     "masking",
     "masking_lobes",
     "evaluation",
+    "footprint",
     "footprint_center",
     "footprint_size",
     "material",
@@ -71,7 +78,7 @@ pub const GLINT_KEYS: &[&str] = &[
     "specular_reflectance",
 ];
 
-/// Standard deviation of the pixel footprint in units of the (scaled) ray-differential
+/// Standard deviation of the pixel footprint in units of the ray-differential
 /// offsets: the Gaussian spans about one differential step (±2σ).
 pub const PIXEL_FOOTPRINT_SIGMA: f64 = 0.5;
 
@@ -107,6 +114,9 @@ pub struct GlintRecipe {
     /// `evaluation = "reference"`: [`PointReferenceBsdf`] at the shading point instead of
     /// the P-BRDF of its footprint.
     pub reference: bool,
+    /// `footprint = "pixel"`: at a camera ray's first hit the renderer passes the pixel's
+    /// footprint (module notes).
+    pub pixel_footprint: bool,
 }
 
 impl GlintRecipe {
@@ -125,6 +135,12 @@ impl GlintRecipe {
         let dx = Vec2::new(derivs[0] * w, derivs[1] * h);
         let dy = Vec2::new(derivs[2] * w, derivs[3] * h);
         Footprint::from_derivatives(center, dx, dy, PIXEL_FOOTPRINT_SIGMA)
+    }
+
+    /// Whether a renderer should pass the pixel's footprint at a camera ray's first hit
+    /// (`footprint = "pixel"`, and not the brute-force reference, which has no footprint).
+    pub fn reads_pixel_footprint(&self) -> bool {
+        self.pixel_footprint && !self.reference
     }
 
     /// The BSDF at the default footprint.
@@ -200,6 +216,17 @@ pub fn parse_glint(
             })
         }
     };
+    let pixel_footprint = match p.str("footprint")?.unwrap_or("ray") {
+        "ray" => false,
+        "pixel" => true,
+        other => {
+            return Err(ParamError::UnknownChoice {
+                what: "glint footprint".into(),
+                given: other.into(),
+                valid: "ray, pixel".into(),
+            })
+        }
+    };
     let fresnel = super::microfacet_models::parse_conductor_fresnel(p)?;
     let tint = check_reflectance(
         "specular_reflectance",
@@ -218,6 +245,7 @@ pub fn parse_glint(
         footprint_center,
         footprint_size,
         reference,
+        pixel_footprint,
     })
 }
 

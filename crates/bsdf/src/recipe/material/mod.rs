@@ -331,6 +331,12 @@ impl MaterialRecipe {
         matches!(self, MaterialRecipe::Glint(_))
     }
 
+    /// Whether the renderer should give this material the footprint of the whole pixel at a
+    /// camera ray's first hit (glints with `footprint = "pixel"`).
+    pub fn reads_pixel_footprint(&self) -> bool {
+        matches!(self, MaterialRecipe::Glint(g) if g.reads_pixel_footprint())
+    }
+
     /// Builds the BSDF of a shading point with texture coordinates `uv` and screen-space
     /// derivatives `[du/dx, dv/dx, du/dy, dv/dy]` (all zero when unknown). Only glints use
     /// them; every other material is [`MaterialRecipe::build`].
