@@ -133,10 +133,12 @@ pub fn radiance(
         if material.reads_surface_details() {
             scene.geometry.complete_hit(&mut hit);
             if let (Some(d), 1) = (&rd, segment) {
-                derivs = hit.uv_derivatives(d);
                 centre = pixel
                     .filter(|_| material.reads_pixel_footprint())
                     .and_then(|p| pixel_shading(scene, &hit, ray.dir, &p));
+                if centre.is_none() {
+                    derivs = hit.uv_derivatives(d);
+                }
             }
         }
         let (uv, derivs, frame) = match centre {

@@ -971,13 +971,13 @@ impl<'s> Kernel<'s> {
         if m.reads_surface_details() {
             self.scene.geometry.complete_hit(&mut hit);
             if let (Some(d), 1) = (&paths.rd[i], paths.segment.lane(i)) {
-                derivs = hit.uv_derivatives(d);
                 let centre = paths.pixel[i]
                     .filter(|_| m.reads_pixel_footprint())
                     .and_then(|p| pixel_shading(self.scene, &hit, paths.d.lane(i), &p));
                 if let Some(c) = centre {
                     return (c.uv, c.derivs, Some(c.frame));
                 }
+                derivs = hit.uv_derivatives(d);
             }
         }
         (hit.uv, derivs, None)

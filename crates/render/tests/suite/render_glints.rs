@@ -13,10 +13,15 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 fn run(scene: &Scene, spp: usize) -> Film {
+    run_with(scene, spp, None)
+}
+
+fn run_with(scene: &Scene, spp: usize, kernel: Option<Kernel>) -> Film {
     let opts = RenderOptions {
         spp: Some(spp),
         seed: 3,
         strategy: Strategy::Mis,
+        kernel,
         ..Default::default()
     };
     let (film, stats) = render(scene, &opts, &AtomicBool::new(false), &|_, _| {}).unwrap();
@@ -163,16 +168,9 @@ fn scratched(footprint: &str) -> Scene {
     load_scene_str(&src, Path::new("t.toml")).unwrap()
 }
 
+/// The grey value of each pixel.
 fn render_with(scene: &Scene, spp: usize, kernel: Kernel) -> Vec<f64> {
-    let opts = RenderOptions {
-        spp: Some(spp),
-        seed: 3,
-        strategy: Strategy::Mis,
-        kernel: Some(kernel),
-        ..Default::default()
-    };
-    let (film, stats) = render(scene, &opts, &AtomicBool::new(false), &|_, _| {}).unwrap();
-    assert_eq!(stats.discarded, 0);
+    let film = run_with(scene, spp, Some(kernel));
     film.sums
         .iter()
         .zip(&film.counts)
