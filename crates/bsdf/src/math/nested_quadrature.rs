@@ -50,6 +50,12 @@ pub trait NestedIntegrand<const C: usize> {
     fn parts(&self) -> usize;
     /// Relative price of one evaluation of `part` (only ratios matter).
     fn cost(&self, part: usize) -> f64;
+    /// `part`'s own first outer segments: break points inside [a, b] that replace the
+    /// ones given to [`NestedQuadrature::new`] (a part that is smoother than another, or
+    /// zero on a stretch, can start on fewer or other segments).
+    fn outer_breaks(&self, _part: usize) -> Option<Vec<f64>> {
+        None
+    }
     /// The inner range (limits and break points) of `part` at outer abscissa x.
     fn inner(&mut self, part: usize, x: f64) -> InnerRange;
     /// Split candidates of `part`'s inner integral at x: asked once, at the first
@@ -294,17 +300,20 @@ impl<const C: usize> NestedQuadrature<C> {
         max_segments: usize,
         f: &mut F,
     ) -> Self {
-        let c = cuts(a, b, outer_breaks);
         let parts: Vec<Part<C>> = (0..f.parts())
-            .map(|p| Part {
-                segments: if b > a {
-                    c.windows(2)
-                        .map(|w| OuterSegment::new(p, w[0], w[1], f))
-                        .collect()
-                } else {
-                    Vec::new()
-                },
-                cost: f.cost(p).max(1e-300),
+            .map(|p| {
+                let own = f.outer_breaks(p);
+                let c = cuts(a, b, own.as_deref().unwrap_or(outer_breaks));
+                Part {
+                    segments: if b > a {
+                        c.windows(2)
+                            .map(|w| OuterSegment::new(p, w[0], w[1], f))
+                            .collect()
+                    } else {
+                        Vec::new()
+                    },
+                    cost: f.cost(p).max(1e-300),
+                }
             })
             .collect();
         let evaluations = parts

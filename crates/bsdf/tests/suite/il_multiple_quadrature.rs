@@ -287,3 +287,57 @@ fn il_wholly_by_quadrature_evaluates_deterministically() {
         assert_ne!(a, b);
     }
 }
+
+#[test]
+fn one_tolerance_puts_body_and_inter_reflections_in_one_quadrature() {
+    // With one `tolerance` for both quadratures, `eval` integrates the body's single
+    // scattering with the inter-reflections (`eval_body_and_multiple`); with a tighter body
+    // tolerance it keeps the two quadratures. Both give f₁ + f_ms within the tolerance of
+    // the value, IL_2 and IL_∞, and the error column bounds the difference.
+    let ctx = BsdfContext::RADIANCE;
+    for scattering in ["double", "multiple"] {
+        let spec = format!(
+            "type = \"il\", kd = 0.8, ni = 1.5, distribution = \"beckmann\", alpha = 0.6, \
+             scattering = \"{scattering}\", evaluation = \"quadrature\", \
+             multiple_evaluation = \"quadrature\""
+        );
+        let one = material(&format!("{{{spec}, tolerance = 1e-4}}"));
+        let lobe = SpecularLobe::new(
+            Ndf::Beckmann(Beckmann::isotropic(0.6).unwrap()),
+            Masking::VCavity,
+            NormalSampling::Visible,
+        )
+        .unwrap();
+        let orders = if scattering == "double" {
+            Scattering::Double
+        } else {
+            Scattering::Multiple
+        };
+        let two = TwoSided::new(
+            InterfacedLambertian::new(
+                Spectrum::splat(0.8),
+                1.5,
+                Some(lobe),
+                BodyEvaluation::Adaptive { tolerance: 1e-9 },
+                orders,
+            )
+            .unwrap()
+            .with_multiple_quadrature(1e-6)
+            .unwrap(),
+        );
+        for (to, ti, pi) in [(0.4, 0.8, 2.0), (1.3, 0.2, 0.3)] {
+            let (wo, wi) = (spherical_direction(to, 0.0), spherical_direction(ti, pi));
+            let (v, e) = one.eval_estimate(wo, wi, &ctx, 0, &mut Pcg32::new(1, 1));
+            assert_eq!(v, one.eval(wo, wi, &ctx, &mut Pcg32::new(3, 3)));
+            let (r, re) = two.eval_estimate(wo, wi, &ctx, 0, &mut Pcg32::new(1, 1));
+            let actual = (v[1] - r[1]).abs();
+            let line = format!(
+                "{scattering} θo {to} θi {ti} φi {pi}: one quadrature {} ± {:.1e}, two {} ± {:.1e} (difference {actual:.1e})",
+                v[1], e[1], r[1], re[1]
+            );
+            assert!(e[1] > 0.0 && e[1] <= 1e-4 * v[1], "{line}");
+            assert!(actual <= e[1] + re[1] && actual <= 1e-4 * r[1], "{line}");
+            println!("{line}");
+        }
+    }
+}
