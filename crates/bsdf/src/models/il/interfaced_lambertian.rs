@@ -367,6 +367,14 @@ impl InterfacedLambertian {
         }
     }
 
+    /// The rough specular lobe f_s [IL18 eq. 4] (0 for flat IL, whose reflection is a delta).
+    fn specular(&self, o: Vec3, i: Vec3) -> Spectrum {
+        match &self.lobe {
+            Some(l) => l.eval(o, i, |c| Spectrum::splat(fresnel_dielectric(c, self.ni))),
+            None => Spectrum::ZERO,
+        }
+    }
+
     /// f_s + f_b (single scattering) for the upper-hemisphere pair (o, i).
     fn single(
         &self,
@@ -375,10 +383,7 @@ impl InterfacedLambertian {
         samples: usize,
         rng: &mut dyn RandomSource,
     ) -> (Spectrum, Spectrum) {
-        let spec = match &self.lobe {
-            Some(l) => l.eval(o, i, |c| Spectrum::splat(fresnel_dielectric(c, self.ni))),
-            None => Spectrum::ZERO,
-        };
+        let spec = self.specular(o, i);
         let (b, se) = self.body_integral(i, o, samples, rng);
         let k = self.body_factor * INV_PI;
         (spec + k * b, k * se)
@@ -431,10 +436,7 @@ impl InterfacedLambertian {
 
     /// f₁ + f_ms by [`Self::body_and_multiple_quadrature`] and its error estimate.
     fn eval_folded(&self, q: &VCavityQuadrature, o: Vec3, i: Vec3) -> (Spectrum, Spectrum) {
-        let spec = match &self.lobe {
-            Some(l) => l.eval(o, i, |c| Spectrum::splat(fresnel_dielectric(c, self.ni))),
-            None => Spectrum::ZERO,
-        };
+        let spec = self.specular(o, i);
         let r = q.eval_body_and_multiple(i, o, spec);
         (spec + r.value, r.error)
     }

@@ -1317,7 +1317,9 @@ const DIRECT_START: usize = 4;
 /// meets the other's (o_z (i·m)_h = −i_z (o·m)_h), and where a direction lies in the
 /// groove's plane ((v·m)_h = 0) — the outer breaks of
 /// [`crate::microfacet::integral::MicrofacetIntegral::integrate`], which integrates the
-/// same term over the normals. Facets at φ and φ + π are one groove, hence mod π.
+/// same term over the normals. Facets at φ and φ + π are one groove, hence mod π. Given to
+/// the direct part as split candidates: 2.7 % (α 1.2) and 1.5 % (α 0.5) fewer evaluations
+/// over 400 random pairs at 1e-4.
 fn single_scattering_breaks(i: Vec3, o: Vec3) -> Vec<f64> {
     let mut out = Vec::with_capacity(4);
     // Zeros of A cos φ + B sin φ, (A, B) = k_i i_h + k_o o_h.
