@@ -350,7 +350,7 @@ async fn material(State(s): State<Shared>, Json(q): Json<MaterialRequest>) -> Re
                 "text": m.text,
                 "table": m.table,
                 "describe": m.bsdf.describe(),
-                "stochastic": m.bsdf.is_stochastic(),
+                "stochastic": !m.bsdf.eval_is_deterministic(),
             }))
             .into_response()
         },

@@ -92,12 +92,15 @@ impl SliceRequest {
     }
 }
 
-/// Fields every view reports about its material.
+/// Fields every view reports about its material. `stochastic` says whether a value is an
+/// average of `samples` estimates (the page then draws ±2 standard errors), i.e. whether
+/// `eval` is random — not whether `sample` is: IL wholly by quadrature evaluates
+/// deterministically while its sampler still walks.
 fn describe(frame: Frame, bsdf: &dyn Bsdf, text: &str) -> Frame {
     frame
         .field("material", text)
         .field("describe", bsdf.describe())
-        .field("stochastic", bsdf.is_stochastic())
+        .field("stochastic", !bsdf.eval_is_deterministic())
         .field(
             "transmits",
             bsdf.flags().intersects(LobeFlags::TRANSMISSION),
@@ -330,6 +333,29 @@ mod tests {
             assert_eq!(f.get("transmit_g").unwrap()[k], 0.0);
         }
         assert_eq!(f.fields["transmits"], false);
+    }
+
+    #[test]
+    fn stochastic_means_a_random_eval() {
+        // IL with body and inter-reflections by quadrature: `sample` walks, `eval` does not.
+        let il = r#"{type = "il", kd = 0.8, alpha = 0.5, scattering = "multiple", evaluation = "quadrature", multiple_evaluation = "quadrature", tolerance = 1e-3}"#;
+        for (text, random) in [
+            (il, false),
+            (r#"{type = "il", kd = 0.8, alpha = 0.5}"#, true),
+            (r#"{type = "lambert"}"#, false),
+        ] {
+            let m = build(text).unwrap();
+            let q = SliceRequest {
+                material: m.text.clone(),
+                theta_i: 30.0,
+                points: 3,
+                quantity: Quantity::F,
+                samples: 4,
+                seed: 1,
+            };
+            let f = slice(&*m.bsdf, &m.text, &q, &Cancel::default()).unwrap();
+            assert_eq!(f.fields["stochastic"], random, "{text}");
+        }
     }
 
     #[test]
