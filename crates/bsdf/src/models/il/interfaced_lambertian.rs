@@ -351,9 +351,11 @@ impl InterfacedLambertian {
                 h,
             ),
             BodyEvaluation::Adaptive { tolerance } => {
-                // With the multiple scattering by quadrature too, the body takes half of the
-                // tolerance and the inter-reflections what the body's error estimate leaves
-                // of tolerance · (f₁ + f_ms) (`multiple_eval`), so that the value meets it.
+                // With the multiple scattering by quadrature too (and a tighter body
+                // tolerance: else `eval` integrates both at once, `eval_folded`), the body
+                // takes half of the tolerance and the inter-reflections what the body's
+                // error estimate leaves of tolerance · (f₁ + f_ms) (`multiple_eval`), so
+                // that the value meets it.
                 let share = if self.ms_quadrature.is_some() {
                     0.5
                 } else {

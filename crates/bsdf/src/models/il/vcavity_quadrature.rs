@@ -1594,6 +1594,18 @@ mod tests {
         }
     }
 
+    /// Both converged, and `v` within the sum of its and the reference's reported errors.
+    fn within_reference(label: &str, v: &MsValue, reference: &MsValue) {
+        let actual = (v.value[1] - reference.value[1]).abs();
+        let line = format!(
+            "{label}: {} ± {:.2e} vs reference {} ± {:.2e} (actual {actual:.2e})",
+            v.value[1], v.error[1], reference.value[1], reference.error[1]
+        );
+        assert!(v.converged && reference.converged, "{line}");
+        assert!(actual <= v.error[1] + reference.error[1], "{line}");
+        println!("{line}");
+    }
+
     #[test]
     fn a_bump_between_the_first_nodes_is_not_missed() {
         // K_d 0.8, n_i 1.5, grazing pairs where the direct part has bumps in φ_m that fall
@@ -1629,14 +1641,7 @@ mod tests {
             let reference = q(tight).eval_in(i, o, rest, Spectrum::ZERO);
             for tol in [1e-4, 1e-5] {
                 let v = q(tol).eval_in(i, o, rest, Spectrum::ZERO);
-                let actual = (v.value[1] - reference.value[1]).abs();
-                let line = format!(
-                    "α {alpha} tol {tol}: {} ± {:.2e} vs reference {} ± {:.2e} (actual {actual:.2e})",
-                    v.value[1], v.error[1], reference.value[1], reference.error[1]
-                );
-                assert!(v.converged && reference.converged, "{line}");
-                assert!(actual <= v.error[1] + reference.error[1], "{line}");
-                println!("{line}");
+                within_reference(&format!("α {alpha} tol {tol}"), &v, &reference);
             }
         }
     }
@@ -1659,14 +1664,7 @@ mod tests {
         let reference = q(1e-7).eval_body_and_multiple(i, o, specular);
         for tol in [1e-4, 1e-5] {
             let v = q(tol).eval_body_and_multiple(i, o, specular);
-            let actual = (v.value[1] - reference.value[1]).abs();
-            let line = format!(
-                "tol {tol}: {} ± {:.2e} vs reference {} ± {:.2e} (actual {actual:.2e})",
-                v.value[1], v.error[1], reference.value[1], reference.error[1]
-            );
-            assert!(v.converged && reference.converged, "{line}");
-            assert!(actual <= v.error[1] + reference.error[1], "{line}");
-            println!("{line}");
+            within_reference(&format!("tol {tol}"), &v, &reference);
         }
     }
 
