@@ -1021,6 +1021,13 @@ const GLINT: &[Param] = &[
         "σ_ε, slope standard deviation added to every lobe",
     )
     .logarithmic(),
+    integer(
+        "seed_subdivision",
+        1,
+        crate::models::glint::microsurface::MAX_SEED_SUBDIVISION as u64,
+        "2",
+        "n, lobes' seeds per texel side (n² lobes a texel, spacing 1/n texels): 1 is the paper's; more is nearer the map where it changes within a texel; 1 by default for maps above 2048²",
+    ),
     choice(
         "masking",
         crate::models::glint::MaskingMode::NAMES,

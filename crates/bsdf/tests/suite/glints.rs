@@ -224,6 +224,62 @@ fn patch_ndf_against_the_interpolated_normal_map() {
 }
 
 #[test]
+fn a_finer_seed_lattice_approaches_the_interpolated_map() {
+    // One lobe per texel (h = 1) smears the flat and the tilted slopes of a texel a scratch
+    // crosses into one Gaussian, at every footprint; seeds at h = ½ and ¼ (CCM19 §5.1.1)
+    // narrow each lobe's neighbourhood. TV distance of D_P to the k_P-weighted histogram of
+    // the interpolated map (eq. 8), on the scratched map, at footprints on and off scratches.
+    let size = 128;
+    let map = generate(NormalMapKind::Scratched, size, 7).unwrap();
+    let surfs: Vec<GlintSurface> = [1, 2, 4]
+        .iter()
+        .map(|&s| GlintSurface::build_with_seeds(map.clone(), 0.01, s, "scratched").unwrap())
+        .collect();
+    println!("centre, footprint σ (texels), TV at h = 1, ½, ¼");
+    let mut sums = [0.0; 3];
+    let mut cases = 0;
+    for center in [
+        Vec2::new(77.3, 41.9),
+        Vec2::new(20.6, 100.2),
+        Vec2::new(63.5, 64.5),
+    ] {
+        for sigma in [0.5, 2.0, 8.0] {
+            let fp = Footprint::isotropic(center, sigma);
+            // One grid for all three: around the map's own slopes under the footprint.
+            let q1 = surfs[0].query(fp);
+            let lobe = PatchMasking::approx(&surfs[0], &q1).filtered_lobe();
+            let half = 4.0 * lobe.cov[0].max(lobe.cov[2]).sqrt().max(0.02);
+            let grid = SlopeGrid::centred(lobe.mean, half, 32);
+            let r = reference_histogram(&map, fp, 0.01, &grid, 4_000_000, 5);
+            let tv: Vec<f64> = surfs
+                .iter()
+                .map(|surf| {
+                    let q = surf.query(fp);
+                    total_variation(&patch_ndf_histogram(&PatchNdf::new(surf, &q), &grid, 3), &r)
+                })
+                .collect();
+            println!(
+                "({:.1}, {:.1}), {sigma}, {:.4}, {:.4}, {:.4}",
+                center.x, center.y, tv[0], tv[1], tv[2]
+            );
+            for k in 0..3 {
+                sums[k] += tv[k];
+            }
+            cases += 1;
+        }
+    }
+    let mean = sums.map(|t| t / cases as f64);
+    println!(
+        "mean TV: h = 1 {:.4}, ½ {:.4}, ¼ {:.4}",
+        mean[0], mean[1], mean[2]
+    );
+    assert!(
+        mean[1] < 0.7 * mean[0] && mean[2] < 0.7 * mean[1],
+        "{mean:?}"
+    );
+}
+
+#[test]
 fn exact_and_approximate_masking_are_measured() {
     let size = 256;
     println!("kind, footprint σ, θ, G1 exact, G1 approx, relative error");
@@ -376,6 +432,7 @@ fn material_syntax_builds_and_reports_errors() {
         r#"{type = "glint", generate = "scratched", resolution = 64}"#,
         r#"{type = "glint", generate = "brushed", resolution = 32, seed = 4, uv_scale = [2, 3], material = "Au", masking = "approx"}"#,
         r#"{type = "glint", generate = "flakes", resolution = 32, footprint_size = [4, 1, 0.5], footprint_center = [0.1, 0.9], eta = 1.5, k = 3.0, roughness_floor = 0.05}"#,
+        r#"{type = "glint", generate = "scratched", resolution = 16, seed_subdivision = 3}"#,
     ];
     for s in ok {
         let b =
@@ -435,6 +492,14 @@ fn material_syntax_builds_and_reports_errors() {
             r#"{type = "glint", generate = "bumpy", evaluation = "brute"}"#,
             "patch, reference",
         ),
+        (
+            r#"{type = "glint", generate = "bumpy", resolution = 16, seed_subdivision = 5}"#,
+            "seed_subdivision",
+        ),
+        (
+            r#"{type = "glint", generate = "bumpy", resolution = 16, seed_subdivision = 0.5}"#,
+            "seed_subdivision",
+        ),
     ];
     for (s, msg) in bad {
         let e = build_material(&parse_inline_table(s).unwrap())
@@ -443,6 +508,30 @@ fn material_syntax_builds_and_reports_errors() {
             .to_string();
         assert!(e.contains(msg), "{s}: {e}");
     }
+}
+
+#[test]
+fn the_seed_lattice_defaults_to_four_lobes_a_texel_within_its_cap() {
+    use facette_bsdf::recipe::material::glint::default_seed_subdivision;
+    let t = parse_inline_table(r#"{type = "glint", generate = "bumpy", resolution = 24}"#).unwrap();
+    let MaterialRecipe::Glint(r) = MaterialRecipe::parse(&t, std::path::Path::new(".")).unwrap()
+    else {
+        panic!("not a glint recipe")
+    };
+    assert_eq!(r.surface.seeds_per_texel(), 2);
+    assert_eq!(r.surface.lattice_size(), (48, 48));
+    assert_eq!(r.surface.lobes().len(), 48 * 48);
+    assert_eq!(default_seed_subdivision(2048 * 2048), 2);
+    assert_eq!(default_seed_subdivision(2049 * 2048), 1);
+    // Past the cap, an explicit subdivision is an error that names it and the limit.
+    let map = NormalMap::from_slopes(2049, 2048, vec![[0.0, 0.0]; 2049 * 2048]).unwrap();
+    let e = GlintSurface::build_with_seeds(map, 0.01, 2, "big")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("seed_subdivision 2") && e.contains("16777216"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -503,6 +592,8 @@ fn sampler_passes_chi_square_and_the_bsdf_checks_at_fixed_footprints() {
     let materials = [
         r#"{type = "glint", generate = "scratched", resolution = 64, roughness_floor = 0.08, footprint_size = 3, material = "Al"}"#,
         r#"{type = "glint", generate = "flakes", resolution = 64, roughness_floor = 0.08, footprint_size = [4, 2, 0.3], masking = "approx", footprint_center = [0.3, 0.6]}"#,
+        // The paper's lattice (the others take the default, four seeds a texel).
+        r#"{type = "glint", generate = "scratched", resolution = 64, roughness_floor = 0.08, footprint_size = 2, seed_subdivision = 1, footprint_center = [0.7, 0.2]}"#,
     ];
     let opts = BsdfCheckOptions {
         chi2: Chi2Config {

@@ -58,7 +58,7 @@ pub struct GlintBsdf {
 impl GlintBsdf {
     pub fn new(surface: Arc<GlintSurface>, footprint: Footprint, params: &GlintParams) -> Self {
         let footprint = footprint.sanitized();
-        let query = FootprintQuery::new(footprint, surface.width(), surface.height());
+        let query = surface.query(footprint);
         let masking = PatchMasking::new(params.masking, &surface, &query, params.masking_lobes);
         GlintBsdf {
             surface,

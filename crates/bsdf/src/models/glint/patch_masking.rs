@@ -125,7 +125,7 @@ pub fn for_each_block(
     l: usize,
     mut f: impl FnMut(Moments, f64),
 ) {
-    let (w, h) = (surface.width(), surface.height());
+    let (w, h) = surface.lattice_size();
     let (lw, lh) = surface.pyramid.level_size(l);
     let lobes = surface.lobes();
     if query.weighting == Weighting::Uniform {

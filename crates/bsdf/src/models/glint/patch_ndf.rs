@@ -99,7 +99,7 @@ impl<'a> PatchNdf<'a> {
         let sf = [s[0] as f32, s[1] as f32];
         let surf = self.surface;
         let q = self.query;
-        let (w, h) = (surf.width(), surf.height());
+        let (w, h) = surf.lattice_size();
         let mut acc = L::zero();
         let mut touched = 0usize;
         let lobes_in =
@@ -187,7 +187,7 @@ impl<'a> PatchNdf<'a> {
     /// 1 − Σ_T W_i/Z of a seed outside the truncation T (module notes).
     pub fn sample_lobe(&self, rng: &mut dyn RandomSource) -> Option<usize> {
         let surf = self.surface;
-        let (w, h) = (surf.width(), surf.height());
+        let (w, h) = surf.lattice_size();
         let q = self.query;
         if q.weighting == Weighting::Uniform {
             let k = ((rng.next_f64() * (w * h) as f64) as usize).min(w * h - 1);

@@ -1,13 +1,19 @@
-//! The precomputed glint surface of one normal map: the map, its lobes (one per texel), the
-//! slope hierarchy and the moment pyramid. Built once per material and shared (behind an
+//! The precomputed glint surface of one normal map: the map, its lobes (one per seed of the
+//! seed lattice: one per texel at the paper's h = 1), the slope hierarchy and the moment
+//! pyramid, all over the seed lattice. Built once per material and shared (behind an
 //! `Arc`) by every per-shading-point [`super::glint_bsdf::GlintBsdf`].
 
+use super::footprint::{Footprint, FootprintQuery};
 use super::hierarchy::SlopeHierarchy;
 use super::lobe_blocks::LobeBlocks;
-use super::microsurface::{build_lobes, check_roughness_floor};
+use super::microsurface::{build_lattice_lobes, check_roughness_floor};
 use super::mip_levels::MomentPyramid;
 use super::normal_map::NormalMap;
-use crate::error::ParamResult;
+use crate::error::{ParamError, ParamResult};
+
+/// The most seeds (lobes) a surface may hold: a 4096² lattice, 640 MiB of lobes, hierarchy
+/// and mip levels at 40 bytes a seed.
+pub const MAX_SEEDS: usize = 4096 * 4096;
 use std::time::Instant;
 
 #[derive(Clone, Debug)]
@@ -16,6 +22,8 @@ pub struct GlintSurface {
     pub(crate) lobes: LobeBlocks,
     pub(crate) hierarchy: SlopeHierarchy,
     pub(crate) pyramid: MomentPyramid,
+    /// Seeds per texel along each axis, 1/h  [CCM19 §5.1.1].
+    seeds_per_texel: usize,
     roughness_floor: f64,
     /// Where the map came from (`scratched 512² seed 1`, a file name).
     label: String,
@@ -55,16 +63,43 @@ impl MemoryReport {
 }
 
 impl GlintSurface {
-    /// Builds lobes, hierarchy and pyramid for `map` with roughness floor σ_ε.
+    /// Builds lobes, hierarchy and pyramid for `map` with roughness floor σ_ε, one seed per
+    /// texel (h = 1, the paper's).
     pub fn build(
         map: NormalMap,
         roughness_floor: f64,
         label: impl Into<String>,
     ) -> ParamResult<Self> {
+        Self::build_with_seeds(map, roughness_floor, 1, label)
+    }
+
+    /// The same with `seeds_per_texel` = n = 1/h seeds per texel side (1 … 4: see
+    /// [`super::microsurface::check_seed_subdivision`]).
+    pub fn build_with_seeds(
+        map: NormalMap,
+        roughness_floor: f64,
+        seeds_per_texel: usize,
+        label: impl Into<String>,
+    ) -> ParamResult<Self> {
         check_roughness_floor(roughness_floor)?;
+        super::microsurface::check_seed_subdivision(seeds_per_texel)?;
+        let seeds = map.texels() * seeds_per_texel * seeds_per_texel;
+        if seeds > MAX_SEEDS {
+            return Err(ParamError::Invalid(format!(
+                "seed_subdivision {seeds_per_texel} on a {}×{} map makes {seeds} lobes \
+                 ({:.1} GiB); at most {MAX_SEEDS} (a 4096² lattice): use a smaller subdivision \
+                 or a smaller map",
+                map.width(),
+                map.height(),
+                seeds as f64 * 40.0 / (1u64 << 30) as f64,
+            )));
+        }
         let t0 = Instant::now();
-        let (w, h) = (map.width(), map.height());
-        let lobes = build_lobes(&map, roughness_floor);
+        let (w, h) = (
+            map.width() * seeds_per_texel,
+            map.height() * seeds_per_texel,
+        );
+        let lobes = build_lattice_lobes(&map, roughness_floor, seeds_per_texel);
         let hierarchy = SlopeHierarchy::build(&lobes, w, h);
         let pyramid = MomentPyramid::build(&lobes, w, h);
         let lobes = LobeBlocks::new(&lobes, w, h);
@@ -73,25 +108,55 @@ impl GlintSurface {
             lobes,
             hierarchy,
             pyramid,
+            seeds_per_texel,
             roughness_floor,
             label: label.into(),
             build_seconds: t0.elapsed().as_secs_f64(),
         })
     }
 
+    /// The map's width in texels.
     pub fn width(&self) -> usize {
         self.map.width()
     }
 
+    /// The map's height in texels.
     pub fn height(&self) -> usize {
         self.map.height()
+    }
+
+    /// Seeds per texel along each axis (1/h).
+    pub fn seeds_per_texel(&self) -> usize {
+        self.seeds_per_texel
+    }
+
+    /// The seed lattice's size (seeds along x and y): the map's size times 1/h. Lobes,
+    /// hierarchy, pyramid and [`FootprintQuery`] are indexed on this lattice.
+    pub fn lattice_size(&self) -> (usize, usize) {
+        (
+            self.map.width() * self.seeds_per_texel,
+            self.map.height() * self.seeds_per_texel,
+        )
+    }
+
+    /// The query of a footprint given in texels: centre and covariance scaled to lattice
+    /// units (one lattice unit is h texels).
+    pub fn query(&self, footprint: Footprint) -> FootprintQuery {
+        let s = self.seeds_per_texel as f64;
+        let fp = footprint.sanitized();
+        let lattice = Footprint {
+            center: fp.center * s,
+            cov: fp.cov.map(|c| c * s * s),
+        };
+        let (w, h) = self.lattice_size();
+        FootprintQuery::new(lattice, w, h)
     }
 
     pub fn map(&self) -> &NormalMap {
         &self.map
     }
 
-    /// The lobes, by leaf block (texel (x, y) with [`LobeBlocks::get`]).
+    /// The lobes, by leaf block (seed (x, y) of the lattice with [`LobeBlocks::get`]).
     pub fn lobes(&self) -> &LobeBlocks {
         &self.lobes
     }

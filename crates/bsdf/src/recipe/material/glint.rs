@@ -15,6 +15,7 @@
 //! | `resolution`, `seed` | size (texels per side) and seed of the generated map | 1–4096; any | 512, 1 |
 //! | `uv_scale` | map repetitions per unit of uv (number or [u, v]) | > 0 | 1 |
 //! | `roughness_floor` | σ_ε, slope standard deviation added to every lobe | (0, 1] | 0.01 |
+//! | `seed_subdivision` | n, seeds of the lobe mixture per texel side (seed spacing h = 1/n texels): 1 is the paper's one lobe per texel; n puts n² lobes in a texel, nearer the map's own slopes where they change within a texel (scratches), at n² times the memory and a query's work (docs/glints.md) | 1–4 | 2 (1 for maps above 2048²) |
 //! | `masking` | `exact` (eqs. 10–17) or `approx` (§4.2.2) | — | `exact` |
 //! | `evaluation` | `patch` (the P-BRDF of the footprint) or `reference` (brute force: the map at the shading point's uv as a σ_ε surface, no footprint; converges with samples per pixel) | — | `patch` |
 //! | `masking_lobes` | budget of the exact masking sum (0: unlimited) | ≥ 0 | 1024 |
@@ -48,6 +49,7 @@ use crate::math::Vec2;
 use crate::models::glint::generate::{generate, NormalMapKind};
 use crate::models::glint::microsurface::DEFAULT_ROUGHNESS_FLOOR;
 use crate::models::glint::patch_masking::{MaskingMode, DEFAULT_MASKING_LOBES};
+use crate::models::glint::surface::MAX_SEEDS;
 use crate::models::glint::{
     Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap, PointReferenceBsdf,
 };
@@ -65,6 +67,7 @@ pub const GLINT_KEYS: &[&str] = &[
     "seed",
     "uv_scale",
     "roughness_floor",
+    "seed_subdivision",
     "masking",
     "masking_lobes",
     "evaluation",
@@ -188,6 +191,17 @@ fn pair(p: &Params, key: &str, default: [f64; 2]) -> ParamResult<[f64; 2]> {
     }
 }
 
+/// The default seed lattice: n = 2, h = ½ (four lobes a texel), where the P-NDF is 4.5×
+/// nearer the interpolated map than at the paper's h = 1 (docs/glints.md), unless that
+/// exceeds [`MAX_SEEDS`] (maps above 2048²): then n = 1.
+pub fn default_seed_subdivision(texels: usize) -> usize {
+    if texels * 4 <= MAX_SEEDS {
+        2
+    } else {
+        1
+    }
+}
+
 /// Parses a `type = "glint"` table (the key check against [`GLINT_KEYS`] is done by the
 /// caller).
 pub fn parse_glint(
@@ -232,7 +246,13 @@ pub fn parse_glint(
         "specular_reflectance",
         p.spectrum("specular_reflectance")?.unwrap_or(Spectrum::ONE),
     )?;
-    let surface = Arc::new(GlintSurface::build(map, floor, label)?);
+    let per_texel = match p.count("seed_subdivision")? {
+        Some(n) => crate::models::glint::microsurface::check_seed_subdivision(n)?,
+        None => default_seed_subdivision(map.texels()),
+    };
+    let surface = Arc::new(GlintSurface::build_with_seeds(
+        map, floor, per_texel, label,
+    )?);
     Ok(GlintRecipe {
         surface,
         params: GlintParams {
