@@ -133,7 +133,7 @@ impl Limit {
 }
 
 /// Every limit, in the order docs/validation.md lists them.
-pub fn all() -> [&'static Limit; 21] {
+pub fn all() -> [&'static Limit; 22] {
     [
         &FILM_PIXELS,
         &FILM_SIDE,
@@ -145,6 +145,7 @@ pub fn all() -> [&'static Limit; 21] {
         &PLOT_POINTS,
         &SAMPLES,
         &RECIPE_COUNT,
+        &GLINT_LOBES,
         &XML_INCLUDES,
         &XML_INCLUDE_DEPTH,
         &XML_DEPTH,
@@ -363,6 +364,16 @@ pub static RECIPE_COUNT: Limit = Limit::new(
     1 << 24,
     1 << 28,
     "16.7 million; the defaults are far below",
+);
+
+/// Lobes of a glint surface: map texels × `seed_subdivision`² (40 bytes each with the
+/// hierarchy and mip levels).
+pub static GLINT_LOBES: Limit = Limit::new(
+    "glint lobes (map texels × seed_subdivision²)",
+    "glint-lobes",
+    1 << 24,
+    1 << 28,
+    "640 MiB at 40 bytes a lobe; use a smaller seed_subdivision or map",
 );
 
 /// Files `<include>`d by a Mitsuba scene, all levels together.

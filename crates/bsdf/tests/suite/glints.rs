@@ -524,7 +524,7 @@ fn the_seed_lattice_defaults_to_four_lobes_a_texel_within_its_cap() {
     else {
         panic!("not a glint recipe")
     };
-    assert_eq!(r.surface.seeds_per_texel(), 2);
+    assert_eq!(r.surface.seed_subdivision(), 2);
     assert_eq!(r.surface.lattice_size(), (48, 48));
     assert_eq!(r.surface.lobes().len(), 48 * 48);
     assert_eq!(default_seed_subdivision(2048 * 2048), 2);
@@ -535,7 +535,7 @@ fn the_seed_lattice_defaults_to_four_lobes_a_texel_within_its_cap() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("seed_subdivision 2") && e.contains("16777216"),
+        e.contains("seed_subdivision 2") && e.contains("16777216") && e.contains("glint-lobes"),
         "{e}"
     );
 }

@@ -10,10 +10,7 @@ use super::microsurface::{build_lattice_lobes, check_roughness_floor};
 use super::mip_levels::MomentPyramid;
 use super::normal_map::NormalMap;
 use crate::error::{ParamError, ParamResult};
-
-/// The most seeds (lobes) a surface may hold: a 4096² lattice, 640 MiB of lobes, hierarchy
-/// and mip levels at 40 bytes a seed.
-pub const MAX_SEEDS: usize = 4096 * 4096;
+use crate::limits::GLINT_LOBES;
 use std::time::Instant;
 
 #[derive(Clone, Debug)]
@@ -22,8 +19,8 @@ pub struct GlintSurface {
     pub(crate) lobes: LobeBlocks,
     pub(crate) hierarchy: SlopeHierarchy,
     pub(crate) pyramid: MomentPyramid,
-    /// Seeds per texel along each axis, 1/h  [CCM19 §5.1.1].
-    seeds_per_texel: usize,
+    /// Seeds per texel side n = 1/h  [CCM19 §3.1, §5.1.1].
+    seed_subdivision: usize,
     roughness_floor: f64,
     /// Where the map came from (`scratched 512² seed 1`, a file name).
     label: String,
@@ -73,33 +70,31 @@ impl GlintSurface {
         Self::build_with_seeds(map, roughness_floor, 1, label)
     }
 
-    /// The same with `seeds_per_texel` = n = 1/h seeds per texel side (1 … 4: see
+    /// The same with n = `seed_subdivision` = 1/h seeds per texel side (1 … 4: see
     /// [`super::microsurface::check_seed_subdivision`]).
     pub fn build_with_seeds(
         map: NormalMap,
         roughness_floor: f64,
-        seeds_per_texel: usize,
+        seed_subdivision: usize,
         label: impl Into<String>,
     ) -> ParamResult<Self> {
         check_roughness_floor(roughness_floor)?;
-        super::microsurface::check_seed_subdivision(seeds_per_texel)?;
-        let seeds = map.texels() * seeds_per_texel * seeds_per_texel;
-        if seeds > MAX_SEEDS {
-            return Err(ParamError::Invalid(format!(
-                "seed_subdivision {seeds_per_texel} on a {}×{} map makes {seeds} lobes \
-                 ({:.1} GiB); at most {MAX_SEEDS} (a 4096² lattice): use a smaller subdivision \
-                 or a smaller map",
-                map.width(),
-                map.height(),
-                seeds as f64 * 40.0 / (1u64 << 30) as f64,
-            )));
-        }
+        super::microsurface::check_seed_subdivision(seed_subdivision)?;
+        GLINT_LOBES
+            .check_product(&[
+                map.width() as u64,
+                map.height() as u64,
+                (seed_subdivision * seed_subdivision) as u64,
+            ])
+            .map_err(|e| {
+                ParamError::Invalid(format!("seed_subdivision {seed_subdivision}: {e}"))
+            })?;
         let t0 = Instant::now();
         let (w, h) = (
-            map.width() * seeds_per_texel,
-            map.height() * seeds_per_texel,
+            map.width() * seed_subdivision,
+            map.height() * seed_subdivision,
         );
-        let lobes = build_lattice_lobes(&map, roughness_floor, seeds_per_texel);
+        let lobes = build_lattice_lobes(&map, roughness_floor, seed_subdivision);
         let hierarchy = SlopeHierarchy::build(&lobes, w, h);
         let pyramid = MomentPyramid::build(&lobes, w, h);
         let lobes = LobeBlocks::new(&lobes, w, h);
@@ -108,7 +103,7 @@ impl GlintSurface {
             lobes,
             hierarchy,
             pyramid,
-            seeds_per_texel,
+            seed_subdivision,
             roughness_floor,
             label: label.into(),
             build_seconds: t0.elapsed().as_secs_f64(),
@@ -125,24 +120,24 @@ impl GlintSurface {
         self.map.height()
     }
 
-    /// Seeds per texel along each axis (1/h).
-    pub fn seeds_per_texel(&self) -> usize {
-        self.seeds_per_texel
+    /// Seeds per texel side, n = 1/h (n² lobes a texel).
+    pub fn seed_subdivision(&self) -> usize {
+        self.seed_subdivision
     }
 
     /// The seed lattice's size (seeds along x and y): the map's size times 1/h. Lobes,
     /// hierarchy, pyramid and [`FootprintQuery`] are indexed on this lattice.
     pub fn lattice_size(&self) -> (usize, usize) {
         (
-            self.map.width() * self.seeds_per_texel,
-            self.map.height() * self.seeds_per_texel,
+            self.map.width() * self.seed_subdivision,
+            self.map.height() * self.seed_subdivision,
         )
     }
 
     /// The query of a footprint given in texels: centre and covariance scaled to lattice
     /// units (one lattice unit is h texels).
     pub fn query(&self, footprint: Footprint) -> FootprintQuery {
-        let s = self.seeds_per_texel as f64;
+        let s = self.seed_subdivision as f64;
         let fp = footprint.sanitized();
         let lattice = Footprint {
             center: fp.center * s,

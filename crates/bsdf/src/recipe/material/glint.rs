@@ -49,7 +49,6 @@ use crate::math::Vec2;
 use crate::models::glint::generate::{generate, NormalMapKind};
 use crate::models::glint::microsurface::DEFAULT_ROUGHNESS_FLOOR;
 use crate::models::glint::patch_masking::{MaskingMode, DEFAULT_MASKING_LOBES};
-use crate::models::glint::surface::MAX_SEEDS;
 use crate::models::glint::{
     Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap, PointReferenceBsdf,
 };
@@ -193,9 +192,10 @@ fn pair(p: &Params, key: &str, default: [f64; 2]) -> ParamResult<[f64; 2]> {
 
 /// The default seed lattice: n = 2, h = ½ (four lobes a texel), where the P-NDF is 4.5×
 /// nearer the interpolated map than at the paper's h = 1 (docs/glints.md), unless that
-/// exceeds [`MAX_SEEDS`] (maps above 2048²): then n = 1.
+/// exceeds the [`GLINT_LOBES`](crate::limits::GLINT_LOBES) limit (by default, maps above
+/// 2048²): then n = 1.
 pub fn default_seed_subdivision(texels: usize) -> usize {
-    if texels * 4 <= MAX_SEEDS {
+    if (texels as u64).saturating_mul(4) <= crate::limits::GLINT_LOBES.max() {
         2
     } else {
         1
