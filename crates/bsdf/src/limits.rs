@@ -373,7 +373,7 @@ pub static GLINT_LOBES: Limit = Limit::new(
     "glint-lobes",
     1 << 24,
     1 << 28,
-    "640 MiB at 40 bytes a lobe; use a smaller seed_subdivision or map",
+    "40 bytes a lobe, 640 MiB at the default; use a smaller seed_subdivision or map",
 );
 
 /// Files `<include>`d by a Mitsuba scene, all levels together.
