@@ -11,7 +11,7 @@
 
 use super::hierarchy::LEAF;
 use super::lobe::{SlopeLobe, CUTOFF_R2};
-use crate::lanes::{F32x8, Real};
+use crate::lanes::{F32x8, Mask, Real};
 
 /// Lobes per block.
 pub const BLOCK: usize = LEAF * LEAF;
@@ -89,6 +89,50 @@ impl LobeBlock {
             let v = L::load(&self.peak[h]) * (L::splat(-0.5) * (q + m)).exp();
             *acc = *acc + L::select(inside, v, L::zero());
         }
+    }
+}
+
+/// Eight lobes as the exact masking sums them (CCM19 eqs. 12–17): mean slope,
+/// covariance (xx, xy, yy) and the seed weight, all 0 in lanes whose weight is 0.
+#[derive(Clone, Copy, Debug)]
+pub struct MaskingLanes {
+    pub mx: F32x8,
+    pub my: F32x8,
+    pub xx: F32x8,
+    pub xy: F32x8,
+    pub yy: F32x8,
+    pub w: F32x8,
+}
+
+impl LobeBlock {
+    /// Half `h` of the block as weighted masking lobes: the covariance from the stored
+    /// inverse, the weight e^{−½ m_j} of the seed at `d0` + (column, row) from the footprint
+    /// centre in the metric `b` (as in [`LobeBlock::accumulate`]) where m_j ≤ R² and the
+    /// lane holds a lobe, 0 elsewhere. `None` when no lane has a weight.
+    #[inline(always)]
+    pub fn weighted_half(&self, h: usize, d0: [f32; 2], b: [f32; 3]) -> Option<MaskingLanes> {
+        type L = F32x8;
+        let dx = L::splat(d0[0] as f64) + LANE_X;
+        let dy = L::splat(d0[1] as f64 + 2.0 * h as f64) + LANE_Y;
+        let [ba, bb, bc] = b.map(|v| L::splat(v as f64));
+        let m = ba * dx * dx + (bb + bb) * dx * dy + bc * dy * dy;
+        let (mx, my) = (self.mean_x[h], self.mean_y[h]);
+        // Lanes past the map's edge hold a NaN mean.
+        let inside = m.le(L::splat(CUTOFF_R2)) & mx.eq(mx);
+        if inside.none() {
+            return None;
+        }
+        let zero = L::zero();
+        let (a, bxy, c) = (self.a[h], self.b[h], self.c[h]);
+        let inv_det = L::one() / L::select(inside, a * c - bxy * bxy, L::one());
+        Some(MaskingLanes {
+            mx: L::select(inside, mx, zero),
+            my: L::select(inside, my, zero),
+            xx: L::select(inside, c * inv_det, zero),
+            xy: L::select(inside, -bxy * inv_det, zero),
+            yy: L::select(inside, a * inv_det, zero),
+            w: L::select(inside, (L::splat(-0.5) * m).exp(), zero),
+        })
     }
 }
 
