@@ -253,7 +253,7 @@ fn level_zero_lanes(surface: &GlintSurface, query: &FootprintQuery) -> (Vec<Mask
         let range = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
             let a = lo.max(0.0);
             let b = hi.min(n as f64 - 1e-9);
-            (b >= a).then(|| ((a as usize) / LEAF, (b as usize) / LEAF))
+            (b >= a).then_some(((a as usize) / LEAF, (b as usize) / LEAF))
         };
         let (Some((bx0, bx1)), Some((by0, by1))) = (
             range(c.x - e.x - ox, c.x + e.x - ox, w),
