@@ -376,12 +376,9 @@ impl PatchMasking {
     }
 
     /// The lobes with their normalized weights (of the approximate term, its one lobe).
-    fn weighted_lobes(&self) -> Box<dyn Iterator<Item = WeightedLobe> + '_> {
-        if self.lanes.is_empty() {
-            Box::new(self.lobes.iter().copied())
-        } else {
-            Box::new(lobes_of(&self.lanes))
-        }
+    /// No allocation: the approximate term's I_P and A_P run through it at every query.
+    fn weighted_lobes(&self) -> impl Iterator<Item = WeightedLobe> + '_ {
+        self.lobes.iter().copied().chain(lobes_of(&self.lanes))
     }
 
     /// The footprint's moment-matched lobe (mean and covariance of P22_P).
