@@ -213,3 +213,74 @@ fn pixel_footprints_depend_less_on_the_sample_count_and_agree_between_kernels() 
     assert!(d_pixel < 0.2 * d_ray, "{d_pixel} vs {d_ray}");
     assert!(d_kernels < 1e-2, "{d_kernels}");
 }
+
+/// The scratched sphere of [`scratched`] with `extra` keys added to its material.
+fn scratched_with(extra: &str) -> Scene {
+    let src = format!(
+        r#"
+        [camera]
+        position = [0, 0, 4]
+        target = [0, 0, 0]
+        fov = 35
+        [film]
+        width = 48
+        height = 48
+        [integrator]
+        max_depth = 2
+        [[objects]]
+        shape = "sphere"
+        radius = 1
+        material = {{ type = "glint", generate = "scratched", resolution = 256, seed = 3, uv_scale = 2, material = "Al", masking = "approx"{extra} }}
+        [[lights]]
+        type = "point"
+        position = [3, 3, 4]
+        intensity = 40
+        "#
+    );
+    load_scene_str(&src, Path::new("t.toml")).unwrap()
+}
+
+fn rms(a: &[f64], b: &[f64]) -> f64 {
+    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+}
+
+/// Issue 20's convergence criterion in small, at the scale of
+/// `scenes/glint-scratched-sphere.toml` (about 6.7 texels a pixel, ray footprints): against
+/// the brute-force reference at 4096 spp, the glint image at 256 spp on the default lattice
+/// (four lobes a texel) is within 1.5× the reference's own error at 256 spp, and the finer
+/// the lattice the nearer (docs/glints.md measures the full scene with
+/// `scripts/glint_convergence.py`: 0.404, 0.160, 0.064 against the reference's 0.148). At
+/// this size the paper's lattice is within the bound too (measured 0.122 against 0.223; n = 2
+/// 0.101, n = 4 0.077): the bias of one lobe per texel shows in the full scene's highlight.
+#[test]
+fn the_glint_image_converges_to_the_brute_force_reference() {
+    let reference = |spp| {
+        render_with(
+            &scratched_with(r#", evaluation = "reference""#),
+            spp,
+            Kernel::Packet,
+        )
+    };
+    let truth = reference(4096);
+    let err = |extra: &str| {
+        rms(
+            &truth,
+            &render_with(&scratched_with(extra), 256, Kernel::Packet),
+        )
+    };
+    let (paper, default, fine) = (
+        err(", seed_subdivision = 1"),
+        err(""),
+        err(", seed_subdivision = 4"),
+    );
+    let own = rms(&truth, &reference(256));
+    println!(
+        "RMSE against the reference at 4096 spp, 256 spp each: reference {own:.4}, \
+         glint n = 1 {paper:.4}, n = 2 (default) {default:.4}, n = 4 {fine:.4}"
+    );
+    assert!(default < 1.5 * own, "{default} vs {own}");
+    assert!(
+        fine < default && default < paper,
+        "{paper} {default} {fine}"
+    );
+}
