@@ -144,28 +144,7 @@ fn example_glint_scenes_load() {
 
 /// A scratched sphere under a point light, 48² pixels, about six texels a pixel.
 fn scratched(footprint: &str) -> Scene {
-    let src = format!(
-        r#"
-        [camera]
-        position = [0, 0, 4]
-        target = [0, 0, 0]
-        fov = 35
-        [film]
-        width = 48
-        height = 48
-        [integrator]
-        max_depth = 2
-        [[objects]]
-        shape = "sphere"
-        radius = 1
-        material = {{ type = "glint", generate = "scratched", resolution = 256, seed = 3, uv_scale = 2, material = "Al", masking = "approx", footprint = "{footprint}" }}
-        [[lights]]
-        type = "point"
-        position = [3, 3, 4]
-        intensity = 40
-        "#
-    );
-    load_scene_str(&src, Path::new("t.toml")).unwrap()
+    scratched_with(&format!(r#", footprint = "{footprint}""#))
 }
 
 /// The grey value of each pixel.
@@ -214,7 +193,8 @@ fn pixel_footprints_depend_less_on_the_sample_count_and_agree_between_kernels() 
     assert!(d_kernels < 1e-2, "{d_kernels}");
 }
 
-/// The scratched sphere of [`scratched`] with `extra` keys added to its material.
+/// The scratched sphere of [`scratched`] with `extra` keys added to its material (approximate
+/// masking, ray footprints unless `extra` says otherwise).
 fn scratched_with(extra: &str) -> Scene {
     let src = format!(
         r#"

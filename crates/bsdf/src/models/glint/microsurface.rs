@@ -42,7 +42,6 @@ use crate::checks::{check_range, Bounds};
 use crate::error::{ParamError, ParamResult};
 use crate::math::quadrature::GaussLegendre;
 use rayon::prelude::*;
-use std::sync::OnceLock;
 
 /// σ_k = h / (2√(2 ln 2)) in lattice units (h = 1): the seed weight's standard deviation.
 pub const SEED_SIGMA: f64 = 0.424_660_900_144_009_5;
@@ -143,16 +142,10 @@ fn lattice_weights(per_texel: usize) -> Vec<SeedWeights> {
         .collect()
 }
 
-fn seed_weights() -> &'static SeedWeights {
-    static W: OnceLock<SeedWeights> = OnceLock::new();
-    W.get_or_init(|| seed_weights_at(0.0, SEED_SIGMA))
-}
-
-/// Slope mean and covariance (xx, xy, yy) of seed (x, y) over the interpolated map, without
-/// the roughness floor  [CCM19 eqs. 5–6].
+/// Slope mean and covariance (xx, xy, yy) of seed (x, y) of the paper's lattice (one seed
+/// per texel) over the interpolated map, without the roughness floor  [CCM19 eqs. 5–6].
 pub fn seed_moments(map: &NormalMap, x: i64, y: i64) -> ([f64; 2], [f64; 3]) {
-    let w = seed_weights();
-    moments_with(map, w, w, x, y)
+    lattice_seed_moments(map, 1, x, y)
 }
 
 /// Seed (i, j) of a lattice of `per_texel` seeds per texel (h = 1/`per_texel`).
@@ -162,9 +155,19 @@ pub fn lattice_seed_moments(
     i: i64,
     j: i64,
 ) -> ([f64; 2], [f64; 3]) {
-    let weights = lattice_weights(per_texel);
-    let (x, y) = (seed_phase(i, per_texel).0, seed_phase(j, per_texel).0);
-    let p = per_texel as i64;
+    lattice_moments(map, &lattice_weights(per_texel), i, j)
+}
+
+/// Seed (i, j) of the lattice whose phases' weights are `weights` (one per phase, n of them).
+fn lattice_moments(
+    map: &NormalMap,
+    weights: &[SeedWeights],
+    i: i64,
+    j: i64,
+) -> ([f64; 2], [f64; 3]) {
+    let n = weights.len();
+    let (x, y) = (seed_phase(i, n).0, seed_phase(j, n).0);
+    let p = n as i64;
     moments_with(
         map,
         &weights[i.rem_euclid(p) as usize],
@@ -260,21 +263,12 @@ pub fn build_lattice_lobes(
     per_texel: usize,
 ) -> Vec<SlopeLobe> {
     let weights = lattice_weights(per_texel);
-    let p = per_texel as i64;
     let lw = map.width() * per_texel;
     (0..map.texels() * per_texel * per_texel)
         .into_par_iter()
         .with_min_len(1024)
         .map(|k| {
-            let (i, j) = ((k % lw) as i64, (k / lw) as i64);
-            let (x, y) = (seed_phase(i, per_texel).0, seed_phase(j, per_texel).0);
-            let (mean, cov) = moments_with(
-                map,
-                &weights[i.rem_euclid(p) as usize],
-                &weights[j.rem_euclid(p) as usize],
-                x,
-                y,
-            );
+            let (mean, cov) = lattice_moments(map, &weights, (k % lw) as i64, (k / lw) as i64);
             SlopeLobe::from_moments(mean, floored_covariance(cov, roughness_floor))
         })
         .collect()
@@ -289,7 +283,7 @@ mod tests {
     fn seed_width_puts_half_maximum_halfway_between_seeds() {
         let g = |x: f64| (-0.5 * x * x / (SEED_SIGMA * SEED_SIGMA)).exp();
         assert!((g(0.5) - 0.5).abs() < 1e-15);
-        let w = seed_weights();
+        let w = seed_weights_at(0.0, SEED_SIGMA);
         assert!((w.lin.iter().sum::<f64>() - 1.0).abs() < 1e-14);
         let total: f64 = w.quad.iter().flatten().sum();
         assert!((total - 1.0).abs() < 1e-14);
@@ -348,11 +342,7 @@ mod tests {
             (4, 15, 11),
         ];
         for (per_texel, i, j) in seeds {
-            let (mean, cov) = if per_texel == 1 {
-                seed_moments(&map, i, j)
-            } else {
-                lattice_seed_moments(&map, per_texel, i, j)
-            };
+            let (mean, cov) = lattice_seed_moments(&map, per_texel, i, j);
             let r = brute_force_moments(&map, per_texel, i, j);
             let got = [mean[0], mean[1], cov[0], cov[1], cov[2]];
             for k in 0..5 {
