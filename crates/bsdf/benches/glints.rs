@@ -22,7 +22,7 @@ use facette_bsdf::models::glint::patch_masking::{
 };
 use facette_bsdf::models::glint::patch_ndf::PatchNdf;
 use facette_bsdf::models::glint::{
-    generate, Footprint, GlintBsdf, GlintParams, GlintSurface, MaskingMode, NormalMapKind,
+    generate, Footprint, GlintBsdf, GlintParams, GlintSurface, MaskingMode, MisPdf, NormalMapKind,
 };
 use facette_bsdf::two_sided::TwoSided;
 use facette_bsdf::{Bsdf, BsdfContext, Vec2, Vec3};
@@ -226,6 +226,7 @@ fn glint_bsdf(c: &mut Criterion) {
             tint: Spectrum::splat(1.0),
             masking: mode,
             masking_lobes: DEFAULT_MASKING_LOBES,
+            mis_pdf: MisPdf::Exact,
         };
         let bsdfs: Vec<TwoSided<GlintBsdf>> = centres()
             .into_iter()

@@ -103,15 +103,31 @@ impl std::ops::BitOr for LobeFlags {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BsdfContext {
     pub mode: TransportMode,
+    /// The caller will not read [`BsdfSample::pdf`] (a path tracer whose only lights are
+    /// delta lights, or that does not weight by MIS, never asks for the density of a sampled
+    /// direction): a model whose density costs more than its sample may then report a cheap
+    /// positive stand-in there (glints [CCM19]: no query of the footprint's lobes). The
+    /// weight, `eval` and `pdf` do not change.
+    pub skip_sample_pdf: bool,
 }
 
 impl BsdfContext {
     pub const RADIANCE: BsdfContext = BsdfContext {
         mode: TransportMode::Radiance,
+        skip_sample_pdf: false,
     };
     pub const IMPORTANCE: BsdfContext = BsdfContext {
         mode: TransportMode::Importance,
+        skip_sample_pdf: false,
     };
+
+    /// This context for a caller that does not read [`BsdfSample::pdf`].
+    pub const fn without_sample_pdf(self) -> BsdfContext {
+        BsdfContext {
+            skip_sample_pdf: true,
+            ..self
+        }
+    }
 }
 
 /// Result of [`Bsdf::sample`].

@@ -122,6 +122,7 @@ pub fn run(a: EvalArgs) -> Result<ExitCode> {
             ModeArg::Radiance => TransportMode::Radiance,
             ModeArg::Importance => TransportMode::Importance,
         },
+        ..Default::default()
     };
     let mut rng = Pcg32::new(a.seed, 0);
     let stdout = std::io::stdout();

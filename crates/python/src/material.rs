@@ -30,6 +30,7 @@ fn context(mode: &str) -> PyResult<BsdfContext> {
                 )))
             }
         },
+        ..Default::default()
     })
 }
 

@@ -62,6 +62,19 @@ pub enum Strategy {
     BsdfOnly,
 }
 
+/// The BSDF context of a render: radiance transport, and whether the density of a BSDF
+/// sample is read. Only MIS reads it, to weight emission that the sampled ray finds, and
+/// only a light that is not a delta light can be found: with delta lights only, or another
+/// strategy, models may skip computing it ([`BsdfContext::skip_sample_pdf`]).
+pub(crate) fn bsdf_context(scene: &Scene, strategy: Strategy) -> BsdfContext {
+    let read = strategy == Strategy::Mis && scene.lights.iter().any(|l| !l.is_delta());
+    if read {
+        BsdfContext::RADIANCE
+    } else {
+        BsdfContext::RADIANCE.without_sample_pdf()
+    }
+}
+
 /// Radiance arriving at the camera along `ray`.
 pub fn radiance(
     scene: &Scene,
@@ -72,7 +85,7 @@ pub fn radiance(
     strategy: Strategy,
 ) -> Spectrum {
     let settings = scene.integrator;
-    let ctx = BsdfContext::RADIANCE;
+    let ctx = bsdf_context(scene, strategy);
     let mut l = Spectrum::ZERO;
     let mut beta = Spectrum::ONE;
     let mut ray = ray;
@@ -257,4 +270,45 @@ fn sample_light(
         power_heuristic(pl, bsdf.pdf(wo, wi, &ctx))
     };
     f * ls.radiance * (w / pl)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene_str;
+    use std::path::Path;
+
+    fn scene(extra: &str) -> Scene {
+        let src = format!(
+            r#"
+            [camera]
+            position = [0, 0, 4]
+            target = [0, 0, 0]
+            [[objects]]
+            shape = "sphere"
+            radius = 1
+            material = {{ type = "diffuse" }}
+            {extra}
+            "#
+        );
+        load_scene_str(&src, Path::new("t.toml")).unwrap()
+    }
+
+    /// MIS reads a BSDF sample's density only where a sampled ray can find emission: not
+    /// with delta lights only, and never without MIS.
+    #[test]
+    fn a_sample_density_is_read_only_where_mis_weighs_found_emission() {
+        let point = scene("[[lights]]\ntype = \"point\"\nposition = [2, 2, 2]\nintensity = 5");
+        let sky = scene("[[lights]]\ntype = \"constant\"\nradiance = 1.0");
+        let area = scene(
+            "[[objects]]\nshape = \"sphere\"\ncenter = [3, 0, 0]\nradius = 0.5\nemission = 2.0",
+        );
+        let skips = |s: &Scene, strategy| bsdf_context(s, strategy).skip_sample_pdf;
+        assert!(skips(&point, Strategy::Mis));
+        assert!(!skips(&sky, Strategy::Mis));
+        assert!(!skips(&area, Strategy::Mis));
+        for s in [&point, &sky, &area] {
+            assert!(skips(s, Strategy::NeeOnly) && skips(s, Strategy::BsdfOnly));
+        }
+    }
 }

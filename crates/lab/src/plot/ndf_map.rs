@@ -77,6 +77,7 @@ mod tests {
             tint: facette_bsdf::math::spectrum::Spectrum::splat(1.0),
             masking: MaskingMode::Approx,
             masking_lobes: 0,
+            mis_pdf: facette_bsdf::models::glint::MisPdf::Filtered,
         };
         GlintBsdf::new(
             surface,

@@ -446,6 +446,7 @@ pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
         sampler: job.sampler,
         cameras: job.cameras,
         strategy: job.strategy,
+        ctx: crate::integrator::bsdf_context(job.scene, job.strategy),
         lane_materials: lane_materials.clone().next().is_some(),
         lobe_numbers: lane_materials.clone().any(|m| m.reads_lobe_number()),
         area_lights: job.scene.shape_light.iter().any(Option::is_some),
@@ -467,6 +468,9 @@ struct Kernel<'a> {
     sampler: &'a PixelSampler,
     cameras: CameraSampling,
     strategy: Strategy,
+    /// The f64 models' context: whether a sample's density is read (see
+    /// [`crate::integrator::bsdf_context`]).
+    ctx: BsdfContext,
     /// Whether some material has a lane model, and whether one of them reads a lobe
     /// number (a textured roughness keeps its material's model kind): which of a vertex's
     /// numbers [`Kernel::vertex_numbers`] draws.
@@ -1367,7 +1371,7 @@ impl<'s> Kernel<'s> {
             }
         }
         // The f64 models, lane by lane, from their vertex's dimensions then the free stream.
-        let ctx = BsdfContext::RADIANCE;
+        let ctx = self.ctx;
         for i in lanes_of(live & !lane_set) {
             let VertexBsdf::Scalar(bsdf) = &vertex.bsdfs[i] else {
                 continue;

@@ -12,23 +12,89 @@
 //! pdf(i) = D_P(h) cos θ_h / (4 o·h)  [WMLT07 eqs. 14, 38; CCM19 §5], the density the
 //! sampler has — not an approximation of it.
 //!
+//! **The density reported for MIS** (`mis_pdf`, [`MisPdf`]). The sampler's density needs
+//! D_P at the sample's half vector — a query of every lobe of the footprint whose support
+//! holds it, where the sample has just found a glint: measured, that query was two thirds of
+//! a render's time (metallic paint, 64 spp). The sample's weight does not need it (D_P
+//! cancels, [`super::patch_reflection`]), only a MIS weight at the next hit does. So:
+//!
+//! - where the caller does not read the sample's density
+//!   ([`BsdfContext::skip_sample_pdf`]: a renderer with delta lights only, or without MIS),
+//!   the sample reports the proxy below and skips the query, whatever `mis_pdf` says;
+//! - `mis_pdf = "exact"` (default): otherwise the sampler's own density;
+//! - `mis_pdf = "filtered"`: `sample` and `pdf` both report the proxy, the density of the
+//!   footprint's *filtered* lobe — the Gaussian with the mean and covariance of P22_P, the
+//!   lobe of CCM19 §4.2.2 — mixed with a small cosine term so that it is positive wherever
+//!   the sampler lands:
+//!
+//!   p̂(i) = (1 − ε) D̂(h) cos θ_h / (4 o·h) + ε cos θ_i / π,  ε = [`MIS_COSINE_SHARE`],
+//!
+//!   and [`Bsdf::pdf_is_exact`](crate::bsdf::Bsdf::pdf_is_exact) is false. MIS stays
+//!   unbiased with any positive density that `sample` and `pdf` report alike
+//!   [Veach 1997, §9.2.2], but the proxy does not see the glints: where it is below the
+//!   sampler's density, light sampling takes a larger share of a glint's peak, where it is
+//!   the worse strategy (measured in docs/glints.md: faster, and noisier under a wide light).
+//!
+//! [`GlintBsdf::sampler_pdf`] gives the sampler's density either way (the chi-square tests).
+//!
+//! [`BsdfContext::skip_sample_pdf`]: crate::bsdf::BsdfContext::skip_sample_pdf
+//!
 //! **Energy.** ∫ f_P I_P(i) dω_i ≤ 1: the P-BRDF conserves energy for the cosine I_P(i)
 //! (the patch's visible projected area). A renderer multiplies by cos θ_i instead; the
 //! two agree on average but differ for a footprint whose mean slope is not zero, where the
 //! albedo w.r.t. cos θ_i can exceed 1 (measured in the tests and docs/glints.md).
 
 use super::footprint::{Footprint, FootprintQuery};
+use super::lobe::LobeF64;
 use super::patch_masking::{MaskingMode, PatchMasking};
 use super::patch_ndf::PatchNdf;
 use super::patch_reflection::{self, PatchReflection};
 use super::surface::GlintSurface;
 use crate::bsdf::{BsdfContext, BsdfSample, LobeFlags};
+use crate::error::{ParamError, ParamResult};
 use crate::fresnel::Fresnel;
 use crate::math::rng::RandomSource;
 use crate::math::spectrum::Spectrum;
-use crate::math::{fmt_num, Vec3};
+use crate::math::{fmt_num, Vec3, PI};
 use crate::two_sided::OpaqueBsdf;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Share of the cosine term in the filtered MIS density (module notes): small enough that
+/// the filtered lobe shapes the MIS weights, large enough that the density is positive
+/// where a narrow lobe far from the footprint's mean lands.
+pub const MIS_COSINE_SHARE: f64 = 0.05;
+
+/// The density a glint BSDF reports for multiple importance sampling (module notes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MisPdf {
+    /// The sampler's own density: one P-NDF query per sample.
+    Exact,
+    /// The footprint's filtered lobe mixed with a cosine term: no query.
+    Filtered,
+}
+
+impl MisPdf {
+    pub const NAMES: &'static [&'static str] = &["filtered", "exact"];
+
+    pub fn parse(s: &str) -> ParamResult<Self> {
+        match s {
+            "filtered" => Ok(MisPdf::Filtered),
+            "exact" => Ok(MisPdf::Exact),
+            other => Err(ParamError::UnknownChoice {
+                what: "glint mis_pdf".into(),
+                given: other.into(),
+                valid: Self::NAMES.join(", "),
+            }),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MisPdf::Exact => "exact",
+            MisPdf::Filtered => "filtered",
+        }
+    }
+}
 
 /// Material parameters besides the surface and the footprint.
 #[derive(Clone, Debug)]
@@ -38,6 +104,43 @@ pub struct GlintParams {
     pub masking: MaskingMode,
     /// Budget of the exact masking sum (0 = unlimited).
     pub masking_lobes: usize,
+    /// The density reported for MIS.
+    pub mis_pdf: MisPdf,
+}
+
+/// The filtered lobe's D, ready to evaluate: mean slope, inverse covariance, and
+/// √det(Σ⁻¹)/2π.
+#[derive(Clone, Copy, Debug)]
+struct FilteredDensity {
+    mean: [f64; 2],
+    inv: [f64; 3],
+    norm: f64,
+}
+
+impl FilteredDensity {
+    fn new(l: &LobeF64) -> Self {
+        let inv = l.inverse();
+        FilteredDensity {
+            mean: l.mean,
+            inv,
+            norm: (inv[0] * inv[2] - inv[1] * inv[1]).max(0.0).sqrt() / (2.0 * PI),
+        }
+    }
+
+    /// D̂(h) = P22(h̃)/cos⁴θ_h of the untruncated Gaussian  [CCM19 eq. 2]; 0 at and below
+    /// the horizon.
+    #[inline]
+    fn d(&self, h: Vec3) -> f64 {
+        let z2 = h.z * h.z;
+        if !(h.z > 0.0) || z2 * z2 < 1e-300 {
+            return 0.0;
+        }
+        let dx = -h.x / h.z - self.mean[0];
+        let dy = -h.y / h.z - self.mean[1];
+        let [a, b, c] = self.inv;
+        let q = a * dx * dx + 2.0 * b * dx * dy + c * dy * dy;
+        self.norm * (-0.5 * q).exp() / (z2 * z2)
+    }
 }
 
 /// The P-BRDF for one footprint (built per shading point; the surface is shared).
@@ -48,6 +151,11 @@ pub struct GlintBsdf {
     fresnel: Fresnel,
     tint: Spectrum,
     footprint: Footprint,
+    /// The footprint's filtered lobe: the proxy density (module notes), made when first
+    /// asked for (an exact-masking footprint's lobes are summed once more).
+    filtered: OnceLock<FilteredDensity>,
+    /// The density reported for MIS.
+    mis_pdf: MisPdf,
     /// I_P of the last `wo`: the integrator asks for the same view direction many times.
     cache: Mutex<Option<(Vec3, f64)>>,
     /// D_P of the last half vector: a light sample's `eval` and `pdf` ask for the same one
@@ -64,6 +172,8 @@ impl GlintBsdf {
             surface,
             query,
             masking,
+            filtered: OnceLock::new(),
+            mis_pdf: params.mis_pdf,
             fresnel: params.fresnel,
             tint: params.tint,
             footprint,
@@ -86,6 +196,17 @@ impl GlintBsdf {
 
     pub fn surface(&self) -> &GlintSurface {
         &self.surface
+    }
+
+    /// The density with which `sample` draws `wi` (upper hemisphere), whatever `pdf`
+    /// reports (module notes).
+    pub fn sampler_pdf(&self, wo: Vec3, wi: Vec3) -> f64 {
+        patch_reflection::sampler_pdf(self, wo, wi)
+    }
+
+    /// The density reported for MIS.
+    pub fn mis_pdf(&self) -> MisPdf {
+        self.mis_pdf
     }
 
     /// I_P(v) for v in the upper hemisphere, remembering the last answer.
@@ -139,6 +260,20 @@ impl PatchReflection for GlintBsdf {
     fn tint(&self) -> Spectrum {
         self.tint
     }
+
+    /// p̂(i) = (1 − ε) D̂(h) cos θ_h / (4 o·h) + ε cos θ_i / π (module notes).
+    #[inline]
+    fn proxy_pdf(&self, o: Vec3, i: Vec3, h: Vec3) -> Option<f64> {
+        let filtered = self
+            .filtered
+            .get_or_init(|| FilteredDensity::new(&self.masking.filtered_lobe()));
+        let lobe = filtered.d(h) * h.z / (4.0 * o.dot(h));
+        Some((1.0 - MIS_COSINE_SHARE) * lobe + MIS_COSINE_SHARE * i.z.max(0.0) / PI)
+    }
+
+    fn reports_proxy(&self) -> bool {
+        self.mis_pdf == MisPdf::Filtered
+    }
 }
 
 impl OpaqueBsdf for GlintBsdf {
@@ -150,12 +285,21 @@ impl OpaqueBsdf for GlintBsdf {
         patch_reflection::eval(self, wo, wi)
     }
 
-    fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
-        patch_reflection::sample(self, wo, rng)
+    fn sample(
+        &self,
+        wo: Vec3,
+        ctx: &BsdfContext,
+        rng: &mut dyn RandomSource,
+    ) -> Option<BsdfSample> {
+        patch_reflection::sample(self, wo, !ctx.skip_sample_pdf, rng)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {
         patch_reflection::pdf(self, wo, wi)
+    }
+
+    fn pdf_is_exact(&self) -> bool {
+        self.mis_pdf == MisPdf::Exact
     }
 
     /// The RMS slope of the footprint's distribution (at least 0.15, so the validation
@@ -174,7 +318,7 @@ impl OpaqueBsdf for GlintBsdf {
         };
         let c = self.footprint.cov;
         format!(
-            "glint({}, footprint centre ({}, {}) texels, cov [{}, {}, {}] texels², masking={} (level {}, {} lobes), {fres})",
+            "glint({}, footprint centre ({}, {}) texels, cov [{}, {}, {}] texels², masking={} (level {}, {} lobes), mis_pdf={}, {fres})",
             self.surface.label(),
             fmt_num(self.footprint.center.x),
             fmt_num(self.footprint.center.y),
@@ -183,7 +327,110 @@ impl OpaqueBsdf for GlintBsdf {
             fmt_num(c[2]),
             self.masking.mode().name(),
             self.masking.level(),
-            self.masking.lobe_count()
+            self.masking.lobe_count(),
+            self.mis_pdf().name()
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::rng::Pcg32;
+    use crate::math::Vec2;
+    use crate::models::glint::{generate, NormalMapKind};
+
+    fn bsdf(kind: NormalMapKind, masking: MaskingMode, mis_pdf: MisPdf) -> GlintBsdf {
+        let map = generate(kind, 32, 4).unwrap();
+        let surface = Arc::new(GlintSurface::build(map, 0.03, "test").unwrap());
+        let params = GlintParams {
+            fresnel: Fresnel::One,
+            tint: Spectrum::splat(0.9),
+            masking,
+            masking_lobes: 0,
+            mis_pdf,
+        };
+        GlintBsdf::new(
+            surface,
+            Footprint::isotropic(Vec2::new(11.3, 7.8), 1.5),
+            &params,
+        )
+    }
+
+    /// The reported density changes, nothing else: the same random numbers give the same
+    /// directions and weights in both modes and contexts; each weight is f cos θ_i over the
+    /// sampler's density (D cancelled, so equal to rounding); the filtered mode reports its
+    /// proxy in the sample and in `pdf` alike, the exact mode the sampler's density — or
+    /// the proxy in a sample where the context says the density is not read.
+    #[test]
+    fn the_filtered_mis_density_changes_only_the_reported_pdf() {
+        let ctx = BsdfContext::RADIANCE;
+        let unread = BsdfContext::RADIANCE.without_sample_pdf();
+        let wo = Vec3::new(0.45, -0.2, 0.87).normalize();
+        for kind in [NormalMapKind::Scratched, NormalMapKind::Flakes] {
+            for masking in [MaskingMode::Exact, MaskingMode::Approx] {
+                let f = bsdf(kind, masking, MisPdf::Filtered);
+                let e = bsdf(kind, masking, MisPdf::Exact);
+                assert!(!f.pdf_is_exact() && e.pdf_is_exact());
+                let mut r = [Pcg32::new(5, 1), Pcg32::new(5, 1), Pcg32::new(5, 1)];
+                let mut accepted = 0;
+                for _ in 0..2000 {
+                    let sf = f.sample(wo, &ctx, &mut r[0]);
+                    let se = e.sample(wo, &ctx, &mut r[1]);
+                    let su = e.sample(wo, &unread, &mut r[2]);
+                    let (Some(sf), Some(se), Some(su)) = (sf, se, su) else {
+                        assert!(sf.is_none() && se.is_none() && su.is_none());
+                        continue;
+                    };
+                    accepted += 1;
+                    assert_eq!(sf.wi, se.wi);
+                    assert_eq!(sf.weight, se.weight);
+                    assert_eq!((su.wi, su.weight, su.pdf), (sf.wi, sf.weight, sf.pdf));
+                    let exact = f.sampler_pdf(wo, sf.wi);
+                    assert!(
+                        (se.pdf - exact).abs() <= 1e-12 * exact,
+                        "{} {exact}",
+                        se.pdf
+                    );
+                    assert_eq!(sf.pdf, f.pdf(wo, sf.wi, &ctx));
+                    assert!(sf.pdf > 0.0 && sf.pdf.is_finite());
+                    let mut r = Pcg32::new(0, 0);
+                    let expect = f.eval(wo, sf.wi, &ctx, &mut r) * (sf.wi.z / exact);
+                    for c in 0..3 {
+                        let (a, b) = (sf.weight[c], expect[c]);
+                        assert!((a - b).abs() <= 1e-9 * b.abs(), "{a} vs {b}");
+                    }
+                }
+                assert!(accepted > 1500, "{accepted}");
+            }
+        }
+    }
+
+    /// The proxy is positive over the whole upper hemisphere (also far from the footprint's
+    /// lobes, and at grazing angles) and finite.
+    #[test]
+    fn the_filtered_mis_density_is_positive_and_finite_everywhere() {
+        let ctx = BsdfContext::RADIANCE;
+        let f = bsdf(
+            NormalMapKind::Scratched,
+            MaskingMode::Approx,
+            MisPdf::Filtered,
+        );
+        let wo = Vec3::new(0.3, 0.1, 0.95).normalize();
+        for t in 0..=60 {
+            for p in 0..32 {
+                let theta = (t as f64 / 60.0) * 0.5 * PI * (1.0 - 1e-9);
+                let phi = p as f64 * 2.0 * PI / 32.0;
+                let wi = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
+                let v = f.pdf(wo, wi, &ctx);
+                assert!(v > 0.0 && v.is_finite(), "{wi:?}: {v}");
+            }
+        }
+        let horizon = Vec3::new(1.0, 0.0, 1e-170).normalize();
+        assert!(f.pdf(horizon, horizon, &ctx).is_finite());
     }
 }

@@ -45,7 +45,7 @@ pub mod surface;
 
 pub use footprint::Footprint;
 pub use generate::{generate, NormalMapKind};
-pub use glint_bsdf::{GlintBsdf, GlintParams};
+pub use glint_bsdf::{GlintBsdf, GlintParams, MisPdf};
 pub use normal_map::{NormalEncoding, NormalMap};
 pub use patch_masking::MaskingMode;
 pub use point_reference::PointReferenceBsdf;

@@ -261,6 +261,8 @@ fn level_zero_lanes(surface: &GlintSurface, query: &FootprintQuery) -> (Vec<Mask
         ) else {
             continue;
         };
+        // Two halves a block at most (growing the list one by one cost 6 % of a render).
+        lanes.reserve(2 * (bx1 - bx0 + 1) * (by1 - by0 + 1));
         for by in by0..=by1 {
             for bx in bx0..=bx1 {
                 // The block's first seed centre relative to the footprint centre.
@@ -290,6 +292,27 @@ pub struct PatchMasking {
     /// The exact term's lobes in lanes, weights normalized (what I_P sums).
     lanes: Vec<MaskingLanes>,
     level: usize,
+}
+
+/// Mean and second moments of the normalized weighted lobes of `lanes`, summed in lanes
+/// (`f32` products, `f64` totals).
+fn lane_moments(lanes: &[MaskingLanes]) -> Moments {
+    let mut acc = [F32x8::splat(0.0); 5];
+    for e in lanes {
+        let (mx, my) = (e.mx, e.my);
+        let wx = e.w * mx;
+        let wy = e.w * my;
+        acc[0] = acc[0] + wx;
+        acc[1] = acc[1] + wy;
+        acc[2] = acc[2] + e.w * e.xx + wx * mx;
+        acc[3] = acc[3] + e.w * e.xy + wx * my;
+        acc[4] = acc[4] + e.w * e.yy + wy * my;
+    }
+    let [mx, my, xx, xy, yy] = acc.map(lane_sum);
+    Moments {
+        mean: [mx, my],
+        second: [xx, xy, yy],
+    }
 }
 
 impl PatchMasking {
@@ -381,17 +404,16 @@ impl PatchMasking {
         self.lobes.iter().copied().chain(lobes_of(&self.lanes))
     }
 
-    /// The footprint's moment-matched lobe (mean and covariance of P22_P).
+    /// The footprint's moment-matched lobe (mean and covariance of the summed lobes'
+    /// P22_P; of the approximate term, its one lobe).
     pub fn filtered_lobe(&self) -> LobeF64 {
-        let mut m = Moments::default();
-        for e in self.weighted_lobes() {
-            let lm = Moments {
+        match self.lobes.first() {
+            Some(e) => LobeF64 {
                 mean: [e[0], e[1]],
-                second: [e[2] + e[0] * e[0], e[3] + e[0] * e[1], e[4] + e[1] * e[1]],
-            };
-            m.add_scaled(&lm, e[5]);
+                cov: [e[2], e[3], e[4]],
+            },
+            None => lane_moments(&self.lanes).lobe(),
         }
-        m.lobe()
     }
 
     /// I_P(v) = ∫ ⟨v, m⟩ D_P(m) dω_m  [CCM19 eq. 12 denominator] (exact), or the single

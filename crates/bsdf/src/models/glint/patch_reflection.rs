@@ -6,6 +6,18 @@
 //! with pdf D(h) cos θ_h / (4 o·h)  [WMLT07 eqs. 14, 38]. Shared by the P-BRDF of a footprint
 //! ([`super::GlintBsdf`]) and the one-lobe brute-force reference
 //! ([`super::PointReferenceBsdf`]), which differ only in D, its sampler and I.
+//!
+//! **The sample weight needs no D.** f cos θ_i / pdf = F (o·h) cos θ_i / (I(o) I(i) cos θ_h):
+//! D cancels, so a sample is weighted exactly without evaluating D at its half vector —
+//! the one query of the footprint's lobes a sample would otherwise cost. D is still needed
+//! for the density a sample reports, which only multiple importance sampling reads. A model
+//! with a cheap positive proxy density ([`PatchReflection::proxy_pdf`]) reports the proxy
+//! where the caller does not read the density ([`BsdfContext::skip_sample_pdf`]), or always
+//! when it says so ([`PatchReflection::reports_proxy`], with [`Bsdf::pdf_is_exact`] false:
+//! MIS stays unbiased with any weights that sum to one).
+//!
+//! [`Bsdf::pdf_is_exact`]: crate::bsdf::Bsdf::pdf_is_exact
+//! [`BsdfContext::skip_sample_pdf`]: crate::bsdf::BsdfContext::skip_sample_pdf
 
 use crate::bsdf::{BsdfSample, LobeFlags};
 use crate::finite::guard;
@@ -26,6 +38,16 @@ pub(crate) trait PatchReflection {
     fn light_area(&self, i: Vec3) -> f64;
     fn fresnel(&self) -> &Fresnel;
     fn tint(&self) -> Spectrum;
+    /// A cheap positive density over the upper hemisphere standing in for the sampler's
+    /// D(h) cos θ_h / (4 o·h), where the model has one (module notes).
+    fn proxy_pdf(&self, _o: Vec3, _i: Vec3, _h: Vec3) -> Option<f64> {
+        None
+    }
+    /// Whether `sample` and `pdf` report [`Self::proxy_pdf`] rather than the sampler's
+    /// density (for multiple importance sampling).
+    fn reports_proxy(&self) -> bool {
+        false
+    }
 }
 
 /// f for an upper-hemisphere pair given D(h) (the sampler has it already).
@@ -59,11 +81,13 @@ pub(crate) fn eval(p: &impl PatchReflection, o: Vec3, i: Vec3) -> Spectrum {
     eval_with_d(p, o, i, cos_oh, p.d(h))
 }
 
-/// One D query per sample: the pdf and f are evaluated at the half vector of (o, i), exactly
-/// as [`pdf`] and [`eval`] compute them.
+/// A sample: a normal of D mirrored, weighted without D (module notes); its reported
+/// density is the model's proxy where the model reports it or `pdf_read` is false, else the
+/// sampler's own (one D query).
 pub(crate) fn sample(
     p: &impl PatchReflection,
     wo: Vec3,
+    pdf_read: bool,
     rng: &mut dyn RandomSource,
 ) -> Option<BsdfSample> {
     if !wo.is_finite() {
@@ -80,15 +104,22 @@ pub(crate) fn sample(
     }
     let h = (o + i).normalize();
     let cos_oh = o.dot(h);
-    if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) {
+    if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) || !(h.z > 0.0) {
         return None;
     }
-    let d = p.d(h);
-    let pdf = d * h.z.max(0.0) / (4.0 * cos_oh);
+    let proxy = (p.reports_proxy() || !pdf_read)
+        .then(|| p.proxy_pdf(o, i, h))
+        .flatten();
+    let pdf = proxy.unwrap_or_else(|| p.d(h) * h.z / (4.0 * cos_oh));
     if !(pdf > 0.0) || !pdf.is_finite() {
         return None;
     }
-    let weight = eval_with_d(p, o, i, cos_oh, d) * (i.z / pdf);
+    let (io, ii) = (p.view_area(o), p.light_area(i));
+    if !(io > 0.0 && ii > 0.0) {
+        return None;
+    }
+    // f cos θ_i / pdf with D cancelled  [CCM19 eq. 7; WMLT07 eqs. 14, 38].
+    let weight = p.tint() * p.fresnel().eval(cos_oh) * (cos_oh * i.z / (io * ii * h.z));
     if !weight.is_finite() {
         return None;
     }
@@ -101,8 +132,22 @@ pub(crate) fn sample(
     })
 }
 
-/// The density of [`sample`] for an upper-hemisphere pair.
+/// The density [`sample`] reports for an upper-hemisphere pair: the model's proxy where it
+/// reports one, else [`sampler_pdf`].
 pub(crate) fn pdf(p: &impl PatchReflection, o: Vec3, i: Vec3) -> f64 {
+    let h = (o + i).normalize_or_zero();
+    let cos_oh = o.dot(h);
+    if !(h.z > 0.0) || !(cos_oh > 0.0) {
+        return 0.0;
+    }
+    match p.reports_proxy().then(|| p.proxy_pdf(o, i, h)).flatten() {
+        Some(v) => guard(v, || format!("glint MIS proxy pdf at o = {o:?}, i = {i:?}")),
+        None => sampler_pdf(p, o, i),
+    }
+}
+
+/// The density with which [`sample`] draws `i` (solid angle), whatever the model reports.
+pub(crate) fn sampler_pdf(p: &impl PatchReflection, o: Vec3, i: Vec3) -> f64 {
     let h = (o + i).normalize_or_zero();
     let cos_oh = o.dot(h);
     if !(h.z > 0.0) || !(cos_oh > 0.0) {

@@ -105,7 +105,7 @@ impl OpaqueBsdf for PointReferenceBsdf {
     }
 
     fn sample(&self, wo: Vec3, _: &BsdfContext, rng: &mut dyn RandomSource) -> Option<BsdfSample> {
-        patch_reflection::sample(self, wo, rng)
+        patch_reflection::sample(self, wo, true, rng)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, _: &BsdfContext) -> f64 {

@@ -19,6 +19,7 @@
 //! | `masking` | `exact` (eqs. 10–17) or `approx` (§4.2.2) | — | `exact` |
 //! | `evaluation` | `patch` (the P-BRDF of the footprint) or `reference` (brute force: the map at the shading point's uv as a σ_ε surface, no footprint; converges with samples per pixel) | — | `patch` |
 //! | `masking_lobes` | budget of the exact masking sum (0: unlimited) | ≥ 0 | 1024 |
+//! | `mis_pdf` | the density reported for multiple importance sampling: `exact` (the sampler's own: one P-NDF query per sampled direction, skipped where the renderer does not weight by MIS — delta lights only) or `filtered` (the footprint's filtered lobe with a 5 % cosine share: no query; unbiased, faster, noisier where BSDF sampling should carry the glints — docs/glints.md) | — | `exact` |
 //! | `footprint` | at a camera ray's hit, `ray` (the sample's own ray-differential footprint, scaled by 1/√spp) or `pixel` (the footprint of the whole pixel under the reconstruction filter, in the shading frame of the pixel's centre: every sample of a pixel shades the same patch, so the glints are converged at a few samples per pixel, at 2.8× the cost of a sample; docs/glints.md) | — | `ray` |
 //! | `footprint_center` | footprint centre in uv when none is given by a renderer | any | [0.5, 0.5] |
 //! | `footprint_size` | footprint standard deviation in texels: σ, [σ_u, σ_v] or [σ_u, σ_v, ρ] | σ ≥ 0, ρ ∈ (−1, 1) | 2 |
@@ -50,7 +51,8 @@ use crate::models::glint::generate::{generate, NormalMapKind};
 use crate::models::glint::microsurface::DEFAULT_ROUGHNESS_FLOOR;
 use crate::models::glint::patch_masking::{MaskingMode, DEFAULT_MASKING_LOBES};
 use crate::models::glint::{
-    Footprint, GlintBsdf, GlintParams, GlintSurface, NormalEncoding, NormalMap, PointReferenceBsdf,
+    Footprint, GlintBsdf, GlintParams, GlintSurface, MisPdf, NormalEncoding, NormalMap,
+    PointReferenceBsdf,
 };
 use crate::recipe::params::Params;
 use crate::two_sided::TwoSided;
@@ -69,6 +71,7 @@ pub const GLINT_KEYS: &[&str] = &[
     "seed_subdivision",
     "masking",
     "masking_lobes",
+    "mis_pdf",
     "evaluation",
     "footprint",
     "footprint_center",
@@ -219,6 +222,7 @@ pub fn parse_glint(
     let (footprint_center, footprint_size) = parse_footprint(p)?;
     let masking = MaskingMode::parse(p.str("masking")?.unwrap_or("exact"))?;
     let masking_lobes = p.count("masking_lobes")?.unwrap_or(DEFAULT_MASKING_LOBES);
+    let mis_pdf = MisPdf::parse(p.str("mis_pdf")?.unwrap_or("exact"))?;
     let reference = match p.str("evaluation")?.unwrap_or("patch") {
         "patch" => false,
         "reference" => true,
@@ -260,6 +264,7 @@ pub fn parse_glint(
             tint,
             masking,
             masking_lobes,
+            mis_pdf,
         },
         uv_scale,
         footprint_center,
