@@ -1042,6 +1042,12 @@ const GLINT: &[Param] = &[
         "budget of the exact masking sum (0: unlimited)",
     ),
     choice(
+        "mis_pdf",
+        crate::models::glint::MisPdf::NAMES,
+        "\"exact\"",
+        "density a sample reports to MIS: the sampler's (one P-NDF query), or the footprint's filtered lobe (no query; noisier under wide lights)",
+    ),
+    choice(
         "evaluation",
         &["patch", "reference"],
         "\"patch\"",

@@ -507,6 +507,10 @@ fn material_syntax_builds_and_reports_errors() {
             r#"{type = "glint", generate = "bumpy", resolution = 16, seed_subdivision = 0.5}"#,
             "seed_subdivision",
         ),
+        (
+            r#"{type = "glint", generate = "bumpy", resolution = 16, mis_pdf = "proxy"}"#,
+            "exact, filtered",
+        ),
     ];
     for (s, msg) in bad {
         let e = build_material(&parse_inline_table(s).unwrap())

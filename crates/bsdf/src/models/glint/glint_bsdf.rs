@@ -74,7 +74,7 @@ pub enum MisPdf {
 }
 
 impl MisPdf {
-    pub const NAMES: &'static [&'static str] = &["filtered", "exact"];
+    pub const NAMES: &'static [&'static str] = &["exact", "filtered"];
 
     pub fn parse(s: &str) -> ParamResult<Self> {
         match s {
