@@ -15,7 +15,7 @@
 //! **The density reported for MIS** (`mis_pdf`, [`MisPdf`]). The sampler's density needs
 //! D_P at the sample's half vector — a query of every lobe of the footprint whose support
 //! holds it, where the sample has just found a glint: measured, that query was two thirds of
-//! a render's time (metallic paint, 64 spp). The sample's weight does not need it (D_P
+//! a render's time (metallic paint, 16 spp, perf). The sample's weight does not need it (D_P
 //! cancels, [`super::patch_reflection`]), only a MIS weight at the next hit does. So:
 //!
 //! - where the caller does not read the sample's density
