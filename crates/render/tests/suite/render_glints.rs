@@ -17,9 +17,13 @@ fn run(scene: &Scene, spp: usize) -> Film {
 }
 
 fn run_with(scene: &Scene, spp: usize, kernel: Option<Kernel>) -> Film {
+    run_seeded(scene, spp, kernel, 3)
+}
+
+fn run_seeded(scene: &Scene, spp: usize, kernel: Option<Kernel>, seed: u64) -> Film {
     let opts = RenderOptions {
         spp: Some(spp),
-        seed: 3,
+        seed,
         strategy: Strategy::Mis,
         kernel,
         ..Default::default()
@@ -305,19 +309,8 @@ fn glint_under_area_light(mode: &str) -> Scene {
 /// otherwise the same).
 #[test]
 fn the_filtered_mis_density_renders_the_same_mean() {
-    let render_seed = |scene: &Scene, seed: u64| {
-        let opts = RenderOptions {
-            spp: Some(128),
-            seed,
-            strategy: Strategy::Mis,
-            ..Default::default()
-        };
-        let (film, stats) = render(scene, &opts, &AtomicBool::new(false), &|_, _| {}).unwrap();
-        assert_eq!(stats.discarded, 0);
-        film
-    };
-    let exact = render_seed(&glint_under_area_light("exact"), 1);
-    let filtered = render_seed(&glint_under_area_light("filtered"), 2);
+    let exact = run_seeded(&glint_under_area_light("exact"), 128, None, 1);
+    let filtered = run_seeded(&glint_under_area_light("filtered"), 128, None, 2);
     // The sphere covers the central pixels (radius 1 at distance 4, fov 32°: ~ 17 px).
     let (me, ee) = exact.block_mean(5, 5, 19, 19);
     let (mf, ef) = filtered.block_mean(5, 5, 19, 19);

@@ -108,41 +108,6 @@ pub struct GlintParams {
     pub mis_pdf: MisPdf,
 }
 
-/// The filtered lobe's D, ready to evaluate: mean slope, inverse covariance, and
-/// √det(Σ⁻¹)/2π.
-#[derive(Clone, Copy, Debug)]
-struct FilteredDensity {
-    mean: [f64; 2],
-    inv: [f64; 3],
-    norm: f64,
-}
-
-impl FilteredDensity {
-    fn new(l: &LobeF64) -> Self {
-        let inv = l.inverse();
-        FilteredDensity {
-            mean: l.mean,
-            inv,
-            norm: (inv[0] * inv[2] - inv[1] * inv[1]).max(0.0).sqrt() / (2.0 * PI),
-        }
-    }
-
-    /// D̂(h) = P22(h̃)/cos⁴θ_h of the untruncated Gaussian  [CCM19 eq. 2]; 0 at and below
-    /// the horizon.
-    #[inline]
-    fn d(&self, h: Vec3) -> f64 {
-        let z2 = h.z * h.z;
-        if !(h.z > 0.0) || z2 * z2 < 1e-300 {
-            return 0.0;
-        }
-        let dx = -h.x / h.z - self.mean[0];
-        let dy = -h.y / h.z - self.mean[1];
-        let [a, b, c] = self.inv;
-        let q = a * dx * dx + 2.0 * b * dx * dy + c * dy * dy;
-        self.norm * (-0.5 * q).exp() / (z2 * z2)
-    }
-}
-
 /// The P-BRDF for one footprint (built per shading point; the surface is shared).
 pub struct GlintBsdf {
     surface: Arc<GlintSurface>,
@@ -153,7 +118,7 @@ pub struct GlintBsdf {
     footprint: Footprint,
     /// The footprint's filtered lobe: the proxy density (module notes), made when first
     /// asked for (an exact-masking footprint's lobes are summed once more).
-    filtered: OnceLock<FilteredDensity>,
+    filtered: OnceLock<LobeF64>,
     /// The density reported for MIS.
     mis_pdf: MisPdf,
     /// I_P of the last `wo`: the integrator asks for the same view direction many times.
@@ -264,10 +229,8 @@ impl PatchReflection for GlintBsdf {
     /// p̂(i) = (1 − ε) D̂(h) cos θ_h / (4 o·h) + ε cos θ_i / π (module notes).
     #[inline]
     fn proxy_pdf(&self, o: Vec3, i: Vec3, h: Vec3) -> Option<f64> {
-        let filtered = self
-            .filtered
-            .get_or_init(|| FilteredDensity::new(&self.masking.filtered_lobe()));
-        let lobe = filtered.d(h) * h.z / (4.0 * o.dot(h));
+        let filtered = self.filtered.get_or_init(|| self.masking.filtered_lobe());
+        let lobe = filtered.d_untruncated(h) * h.z / (4.0 * o.dot(h));
         Some((1.0 - MIS_COSINE_SHARE) * lobe + MIS_COSINE_SHARE * i.z.max(0.0) / PI)
     }
 

@@ -204,13 +204,14 @@ impl LobeF64 {
         (a * c - b * b).max(0.0).sqrt() / TWO_PI * (-0.5 * q).exp()
     }
 
-    /// Untruncated D(m) = P22(m̃)/cos⁴θ_m  [CCM19 eq. 2] (for numerical checks).
+    /// Untruncated D(m) = P22(m̃)/cos⁴θ_m  [CCM19 eq. 2] (numerical checks, and the glint
+    /// material's MIS proxy); 0 at and below the horizon, where cos⁴θ_m underflows.
     pub fn d_untruncated(&self, m: Vec3) -> f64 {
-        if m.z <= 0.0 {
+        let z2 = m.z * m.z;
+        if !(m.z > 0.0) || z2 * z2 < 1e-300 {
             return 0.0;
         }
         let s = [-m.x / m.z, -m.y / m.z];
-        let z2 = m.z * m.z;
         self.p22_untruncated(s) / (z2 * z2)
     }
 
