@@ -1032,7 +1032,7 @@ const GLINT: &[Param] = &[
         "masking",
         crate::models::glint::MaskingMode::NAMES,
         "\"exact\"",
-        "exact patch masking (CCM19 eqs. 10–17), or the approximation of §4.2.2",
+        "exact patch masking (CCM19 eqs. 10–17), or the approximation of §4.2.2 taken per mip block (at most 16 filtered lobes)",
     ),
     integer(
         "masking_lobes",

@@ -20,10 +20,20 @@
 //! moment-matched lobe weighted by its area — exact at level 0, an approximation beyond
 //! (measured in the tests and docs/glints.md).
 //!
-//! **Approximate** (`masking = "approx"`, §4.2.2): one Beckmann lobe whose mean, standard
-//! deviations and correlation are the W-weighted moments of the footprint, read from the
-//! mip level at which the footprint spans at most [`APPROX_BLOCKS`] texels; its Λ and
-//! projected area give G1 and A_P. Computed once per footprint, so a query costs one erfc.
+//! **Approximate** (`masking = "approx"`, after §4.2.2): the same sum over the blocks of
+//! the mip level at which the footprint spans at most [`APPROX_BLOCKS`] of them, each
+//! block one Beckmann lobe with the W-weighted moments of its seeds — CCM19's filtered
+//! lobe taken per block, not once for the whole footprint. A query costs at most a few
+//! lane groups (two for 16 blocks).
+//!
+//! Why not the paper's single lobe (ERRATA 18): I_P enters the P-BRDF's denominator, and a Gaussian's
+//! tail is far lighter than the mixture's. Where a footprint's mean facet turns away from a
+//! grazing direction, the single lobe's I_P underflows while the footprint still has
+//! facets facing that direction: measured on 256² flakes at θ_o 80–90°, the sampler's
+//! weight (F = 1) reached 4.5e19 with a mean of 1.8e14 — pixels of 1e18 and beyond at a
+//! sphere's silhouette. With the blocks' mixture the largest weight is 1.0e3 and the mean
+//! 1.45, as the exact term's (6.3e3 and 1.53; the albedo w.r.t. cos θ_i may exceed 1 for a
+//! tilted footprint, see [`super::glint_bsdf`]); test `approximate_masking_is_bounded_at_grazing_views`.
 //!
 //! Block weights at level l: area · N(centre; c, Σ_P + v_l I) with v_l = σ_k² + (4^l − 1)/12,
 //! the second moment of the seed weights summed over a 2^l × 2^l block (σ_k² at level 0,
@@ -44,7 +54,7 @@ use crate::math::{Vec2, Vec3, PI};
 /// Default budget of lobes summed by the exact masking term.
 pub const DEFAULT_MASKING_LOBES: usize = 1024;
 
-/// Blocks (at most) averaged into the approximate term's single lobe.
+/// Blocks (at most) whose filtered lobes the approximate term sums.
 pub const APPROX_BLOCKS: f64 = 16.0;
 
 /// Which masking-shadowing and projected area the P-BRDF uses.
@@ -52,7 +62,7 @@ pub const APPROX_BLOCKS: f64 = 16.0;
 pub enum MaskingMode {
     /// CCM19 eqs. 13–17 summed over the footprint's lobes.
     Exact,
-    /// CCM19 §4.2.2: one mip-filtered lobe.
+    /// CCM19 §4.2.2 per block: the filtered lobes of at most [`APPROX_BLOCKS`] mip blocks.
     Approx,
 }
 
@@ -197,19 +207,29 @@ const EMPTY_LANES: MaskingLanes = MaskingLanes {
     w: F32x8([0.0; 8]),
 };
 
-/// `lobes` eight to a lane group, in order (unused lanes weigh 0).
+/// Appends lobe number `n` (counted from 0) to `lanes`, eight to a lane group, in order
+/// (unused lanes weigh 0).
+fn push_lobe(lanes: &mut Vec<MaskingLanes>, n: usize, e: &WeightedLobe) {
+    let j = n % 8;
+    if j == 0 {
+        lanes.push(EMPTY_LANES);
+    }
+    let c = lanes.last_mut().expect("a lane group was pushed at lane 0");
+    for (field, v) in [
+        &mut c.mx, &mut c.my, &mut c.xx, &mut c.xy, &mut c.yy, &mut c.w,
+    ]
+    .into_iter()
+    .zip(e)
+    {
+        field.0[j] = *v as f32;
+    }
+}
+
+/// `lobes` eight to a lane group, in order.
 fn lanes_of(lobes: &[WeightedLobe]) -> Vec<MaskingLanes> {
-    let mut out = vec![EMPTY_LANES; lobes.len().div_ceil(8)];
-    for (k, e) in lobes.iter().enumerate() {
-        let (c, j) = (&mut out[k / 8], k % 8);
-        for (field, v) in [
-            &mut c.mx, &mut c.my, &mut c.xx, &mut c.xy, &mut c.yy, &mut c.w,
-        ]
-        .into_iter()
-        .zip(e)
-        {
-            field.0[j] = *v as f32;
-        }
+    let mut out = Vec::with_capacity(lobes.len().div_ceil(8));
+    for (n, e) in lobes.iter().enumerate() {
+        push_lobe(&mut out, n, e);
     }
     out
 }
@@ -228,17 +248,11 @@ fn lobes_of(lanes: &[MaskingLanes]) -> impl Iterator<Item = WeightedLobe> + '_ {
 /// half at a time in lanes: what [`for_each_block`] gives at level 0, without a lobe's
 /// round trip through its moments. Returns the lanes and the weights' sum.
 fn level_zero_lanes(surface: &GlintSurface, query: &FootprintQuery) -> (Vec<MaskingLanes>, f64) {
-    let lobes = surface.lobes();
-    let mut out = Vec::new();
-    let mut total = 0.0;
     if query.weighting == Weighting::Uniform {
-        for_each_block(surface, query, 0, |m, w| {
-            let l = m.lobe();
-            out.push([l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], w]);
-            total += w;
-        });
-        return (lanes_of(&out), total);
+        return block_lanes(surface, query, 0);
     }
+    let lobes = surface.lobes();
+    let mut total = 0.0;
     let (w, h) = surface.lattice_size();
     let s = query.s;
     let det = (s[0] * s[2] - s[1] * s[1]).max(1e-300);
@@ -283,13 +297,35 @@ fn level_zero_lanes(surface: &GlintSurface, query: &FootprintQuery) -> (Vec<Mask
     (lanes, total)
 }
 
+/// The blocks of level `l` in the footprint as lobes in lanes, packed (no empty lanes),
+/// with the weights' sum.
+fn block_lanes(
+    surface: &GlintSurface,
+    query: &FootprintQuery,
+    l: usize,
+) -> (Vec<MaskingLanes>, f64) {
+    // Room for the approximate term's ~16 blocks: this runs at every shading point.
+    let mut lanes = Vec::with_capacity(3);
+    let mut n = 0;
+    let mut total = 0.0;
+    for_each_block(surface, query, l, |m, w| {
+        let l = m.lobe();
+        push_lobe(
+            &mut lanes,
+            n,
+            &[l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], w],
+        );
+        n += 1;
+        total += w;
+    });
+    (lanes, total)
+}
+
 /// The masking term of one footprint.
 #[derive(Clone, Debug)]
 pub struct PatchMasking {
     mode: MaskingMode,
-    /// The approximate term's single lobe (empty for the exact term).
-    lobes: Vec<WeightedLobe>,
-    /// The exact term's lobes in lanes, weights normalized (what I_P sums).
+    /// The lobes in lanes, weights normalized (what I_P sums).
     lanes: Vec<MaskingLanes>,
     level: usize,
 }
@@ -319,57 +355,40 @@ impl PatchMasking {
     /// CCM19 eqs. 13–17 over the footprint's lobes (module notes on `budget`).
     pub fn exact(surface: &GlintSurface, query: &FootprintQuery, budget: usize) -> Self {
         let level = choose_level(surface, query, budget as f64);
-        let (mut lanes, total) = if level == 0 {
+        let (lanes, total) = if level == 0 {
             level_zero_lanes(surface, query)
         } else {
-            let mut lobes = Vec::new();
-            let mut total = 0.0;
-            for_each_block(surface, query, level, |m, w| {
-                let l = m.lobe();
-                lobes.push([l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], w]);
-                total += w;
-            });
-            (lanes_of(&lobes), total)
+            block_lanes(surface, query, level)
         };
+        Self::normalized(MaskingMode::Exact, lanes, total, level)
+    }
+
+    /// CCM19 §4.2.2 per block: the moment-matched lobes of the at most [`APPROX_BLOCKS`]
+    /// blocks of the footprint's level (module notes).
+    pub fn approx(surface: &GlintSurface, query: &FootprintQuery) -> Self {
+        let level = choose_level(surface, query, APPROX_BLOCKS);
+        let (lanes, total) = block_lanes(surface, query, level);
+        Self::normalized(MaskingMode::Approx, lanes, total, level)
+    }
+
+    /// The term with its weights divided by their sum. A footprint whose truncation holds
+    /// no lobe (it does not happen for a sanitized footprint; kept finite all the same)
+    /// gets one narrow lobe around the normal.
+    fn normalized(
+        mode: MaskingMode,
+        mut lanes: Vec<MaskingLanes>,
+        total: f64,
+        level: usize,
+    ) -> Self {
         if total > 0.0 {
             let scale = F32x8::splat(1.0 / total);
             for l in lanes.iter_mut() {
                 l.w = l.w * scale;
             }
-        }
-        PatchMasking {
-            mode: MaskingMode::Exact,
-            lobes: Vec::new(),
-            lanes,
-            level,
-        }
-    }
-
-    /// CCM19 §4.2.2: the single W-weighted, moment-matched lobe.
-    pub fn approx(surface: &GlintSurface, query: &FootprintQuery) -> Self {
-        let level = choose_level(surface, query, APPROX_BLOCKS);
-        let mut acc = Moments::default();
-        let mut total = 0.0;
-        for_each_block(surface, query, level, |m, w| {
-            acc.add_scaled(&m, w);
-            total += w;
-        });
-        let m = if total > 0.0 {
-            acc.scaled(1.0 / total)
         } else {
-            Moments {
-                mean: [0.0; 2],
-                second: [1e-4, 0.0, 1e-4],
-            }
-        };
-        let l = m.lobe();
-        let lobes = vec![[l.mean[0], l.mean[1], l.cov[0], l.cov[1], l.cov[2], 1.0]];
-        PatchMasking {
-            mode: MaskingMode::Approx,
-            lanes: Vec::new(),
-            lobes,
-            level,
+            lanes = lanes_of(&[[0.0, 0.0, 1e-4, 0.0, 1e-4, 1.0]]);
         }
+        PatchMasking { mode, lanes, level }
     }
 
     pub fn new(
@@ -398,34 +417,24 @@ impl PatchMasking {
         self.weighted_lobes().count()
     }
 
-    /// The lobes with their normalized weights (of the approximate term, its one lobe).
-    /// No allocation: the approximate term's I_P and A_P run through it at every query.
+    /// The lobes with their normalized weights.
     fn weighted_lobes(&self) -> impl Iterator<Item = WeightedLobe> + '_ {
-        self.lobes.iter().copied().chain(lobes_of(&self.lanes))
+        lobes_of(&self.lanes)
     }
 
-    /// The footprint's moment-matched lobe (mean and covariance of the summed lobes'
-    /// P22_P; of the approximate term, its one lobe).
+    /// The footprint's moment-matched lobe: mean and covariance of the summed lobes'
+    /// P22_P (the single lobe of CCM19 §4.2.2).
     pub fn filtered_lobe(&self) -> LobeF64 {
-        match self.lobes.first() {
-            Some(e) => LobeF64 {
-                mean: [e[0], e[1]],
-                cov: [e[2], e[3], e[4]],
-            },
-            None => lane_moments(&self.lanes).lobe(),
-        }
+        lane_moments(&self.lanes).lobe()
     }
 
-    /// I_P(v) = ∫ ⟨v, m⟩ D_P(m) dω_m  [CCM19 eq. 12 denominator] (exact), or the single
-    /// lobe's A(1 + Λ) (approximate). `v` in the upper hemisphere. The exact sum runs in
-    /// `f32` lanes (AVX2 where the CPU has it, the same bits; [`expected_positive_part_lanes`]),
-    /// within 2e-5 (relative) of [`PatchMasking::visible_projected_area_f64`] (tested);
-    /// the single lobe of the approximate term in `f64`.
+    /// I_P(v) = ∫ ⟨v, m⟩ D_P(m) dω_m  [CCM19 eq. 12 denominator] over the term's lobes
+    /// (exact: the footprint's; approximate: its blocks'). `v` in the upper hemisphere. The
+    /// sum runs in `f32` lanes (AVX2 where the CPU has it, the same bits;
+    /// [`expected_positive_part_lanes`]), within 2e-5 (relative) of
+    /// [`PatchMasking::visible_projected_area_f64`] (tested).
     #[inline]
     pub fn visible_projected_area(&self, v: Vec3) -> f64 {
-        if self.lanes.is_empty() {
-            return self.visible_projected_area_f64(v);
-        }
         #[cfg(target_arch = "x86_64")]
         if crate::lanes::avx2::available() {
             // SAFETY: the CPU has AVX2 and FMA (tested just above).
@@ -468,7 +477,7 @@ impl PatchMasking {
         sum
     }
 
-    /// A_P(v)  [CCM19 eq. 17] (approximate: from the filtered mean slope).
+    /// A_P(v)  [CCM19 eq. 17] (approximate: from the blocks' mean slopes).
     pub fn projected_area(&self, v: Vec3) -> f64 {
         self.weighted_lobes()
             .map(|e| e[5] * (v.z - v.x * e[0] - v.y * e[1]).max(0.0))

@@ -16,7 +16,7 @@
 //! | `uv_scale` | map repetitions per unit of uv (number or [u, v]) | > 0 | 1 |
 //! | `roughness_floor` | σ_ε, slope standard deviation added to every lobe | (0, 1] | 0.01 |
 //! | `seed_subdivision` | n, seeds of the lobe mixture per texel side (seed spacing h = 1/n texels): 1 is the paper's one lobe per texel; n puts n² lobes in a texel, nearer the map's own slopes where they change within a texel (scratches), at n² times the memory and a query's work (docs/glints.md) | 1–4 | 2 (1 for maps above 2048²) |
-//! | `masking` | `exact` (eqs. 10–17) or `approx` (§4.2.2) | — | `exact` |
+//! | `masking` | `exact` (eqs. 10–17) or `approx` (§4.2.2, per mip block: ERRATA 18) | — | `exact` |
 //! | `evaluation` | `patch` (the P-BRDF of the footprint) or `reference` (brute force: the map at the shading point's uv as a σ_ε surface, no footprint; converges with samples per pixel) | — | `patch` |
 //! | `masking_lobes` | budget of the exact masking sum (0: unlimited) | ≥ 0 | 1024 |
 //! | `mis_pdf` | the density reported for multiple importance sampling: `exact` (the sampler's own: one P-NDF query per sampled direction, skipped where the renderer does not weight by MIS — delta lights only) or `filtered` (the footprint's filtered lobe with a 5 % cosine share: no query; unbiased, faster, noisier where BSDF sampling should carry the glints — docs/glints.md) | — | `exact` |
