@@ -239,17 +239,38 @@ impl FootprintQuery {
 }
 
 /// Σ over the lattice u = n + ½ (n ∈ ℤ²) of N(u; c, S), by Poisson summation (module notes).
+///
+/// Runs at every shading point. The terms of m and −m are equal (the exponent and the cosine
+/// are even), so the half plane {m_y > 0} ∪ {m_y = 0, m_x > 0} is summed twice, plus m = 0;
+/// the phases cos 2π(m_x p_x + m_y p_y) are the real parts of products of powers of
+/// e^{2πi p_x} and e^{2πi p_y} — two `sin_cos` in place of 48 cosines (perf had the cosines
+/// at 8 % of a brushed-plate render) and half the exponentials.
 pub fn lattice_gaussian_sum(s: [f64; 3], c: Vec2) -> f64 {
-    let (px, py) = (c.x - 0.5, c.y - 0.5);
-    let mut z = 0.0;
-    for my in -3i32..=3 {
-        for mx in -3i32..=3 {
+    /// (cos 2πkp, sin 2πkp) for k = 0..=3.
+    fn phase_powers(p: f64) -> [(f64, f64); 4] {
+        let (sin, cos) = (2.0 * PI * p).sin_cos();
+        let mut z = [(1.0, 0.0); 4];
+        for k in 1..4 {
+            let (a, b) = z[k - 1];
+            z[k] = (a * cos - b * sin, a * sin + b * cos);
+        }
+        z
+    }
+    let zx = phase_powers(c.x - 0.5);
+    let zy = phase_powers(c.y - 0.5);
+    let mut z = 1.0;
+    for my in 0i32..=3 {
+        let (ay, by) = zy[my as usize];
+        for mx in if my == 0 { 1 } else { -3 }..=3i32 {
             let (fx, fy) = (mx as f64, my as f64);
             let e = 2.0 * PI * PI * (s[0] * fx * fx + 2.0 * s[1] * fx * fy + s[2] * fy * fy);
             if e > 40.0 {
                 continue;
             }
-            z += (-e).exp() * (2.0 * PI * (fx * px + fy * py)).cos();
+            // e^{−2πi k p} is the conjugate of e^{2πi k p}.
+            let (ax, bx) = zx[mx.unsigned_abs() as usize];
+            let bx = if mx < 0 { -bx } else { bx };
+            z += 2.0 * (-e).exp() * (ax * ay - bx * by);
         }
     }
     z
@@ -295,6 +316,9 @@ mod tests {
             ),
             ([0.4, 0.1, 0.25], Vec2::new(1.1, 7.9)),
             ([4.0, -1.5, 2.0], Vec2::new(0.0, 0.3)),
+            // Sub-texel (near λ_min(S) = σ_k², where the most terms count) and correlated.
+            ([0.2, 0.01, 0.19], Vec2::new(0.37, 0.81)),
+            ([0.25, -0.05, 0.3], Vec2::new(-2.9, 5.13)),
         ] {
             let det = s[0] * s[2] - s[1] * s[1];
             let inv = [s[2] / det, -s[1] / det, s[0] / det];
