@@ -20,7 +20,7 @@
 //!
 //! - where the caller does not read the sample's density
 //!   ([`BsdfContext::skip_sample_pdf`]: a renderer with delta lights only, or without MIS),
-//!   the sample reports the proxy below and skips the query, whatever `mis_pdf` says;
+//!   the sample skips the query and reports cos θ_i / π (`filtered`: its proxy, as always);
 //! - `mis_pdf = "exact"` (default): otherwise the sampler's own density;
 //! - `mis_pdf = "filtered"`: `sample` and `pdf` both report the proxy, the density of the
 //!   footprint's *filtered* lobe — the Gaussian with the mean and covariance of P22_P, the
@@ -324,7 +324,7 @@ mod tests {
     /// directions and weights in both modes and contexts; each weight is f cos θ_i over the
     /// sampler's density (D cancelled, so equal to rounding); the filtered mode reports its
     /// proxy in the sample and in `pdf` alike, the exact mode the sampler's density — or
-    /// the proxy in a sample where the context says the density is not read.
+    /// cos θ_i / π in a sample where the context says the density is not read.
     #[test]
     fn the_filtered_mis_density_changes_only_the_reported_pdf() {
         let ctx = BsdfContext::RADIANCE;
@@ -335,7 +335,7 @@ mod tests {
                 let f = bsdf(kind, masking, MisPdf::Filtered);
                 let e = bsdf(kind, masking, MisPdf::Exact);
                 assert!(!f.pdf_is_exact() && e.pdf_is_exact());
-                let mut r = [Pcg32::new(5, 1), Pcg32::new(5, 1), Pcg32::new(5, 1)];
+                let mut r = [(); 4].map(|_| Pcg32::new(5, 1));
                 let mut accepted = 0;
                 for _ in 0..2000 {
                     let sf = f.sample(wo, &ctx, &mut r[0]);
@@ -343,12 +343,17 @@ mod tests {
                     let su = e.sample(wo, &unread, &mut r[2]);
                     let (Some(sf), Some(se), Some(su)) = (sf, se, su) else {
                         assert!(sf.is_none() && se.is_none() && su.is_none());
+                        assert!(f.sample(wo, &unread, &mut r[3]).is_none());
                         continue;
                     };
                     accepted += 1;
                     assert_eq!(sf.wi, se.wi);
                     assert_eq!(sf.weight, se.weight);
-                    assert_eq!((su.wi, su.weight, su.pdf), (sf.wi, sf.weight, sf.pdf));
+                    assert_eq!((su.wi, su.weight), (sf.wi, sf.weight));
+                    assert_eq!(su.pdf, su.wi.z / PI);
+                    // The filtered mode reports its proxy in every context.
+                    let sfu = f.sample(wo, &unread, &mut r[3]).expect("same draws as sf");
+                    assert_eq!((sfu.wi, sfu.pdf), (sf.wi, sf.pdf));
                     let exact = f.sampler_pdf(wo, sf.wi);
                     assert!(
                         (se.pdf - exact).abs() <= 1e-12 * exact,
