@@ -185,10 +185,9 @@ pub fn for_each_block(
                     continue;
                 }
                 let area = ((x1 - x0) * (y1 - y0)) as f64;
-                f(
-                    surface.pyramid.moments(lobes, l, bx, by),
-                    area * (-0.5 * q).exp(),
-                );
+                // An `f32` exponential: the weight is stored in `f32` lanes anyway.
+                let weight = f64::from((-0.5 * q as f32).exp());
+                f(surface.pyramid.moments(lobes, l, bx, by), area * weight);
             }
         }
     }
