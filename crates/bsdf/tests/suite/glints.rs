@@ -320,6 +320,73 @@ fn exact_and_approximate_masking_are_measured() {
 }
 
 #[test]
+fn approximate_visible_area_is_measured_against_the_exact_sum() {
+    // I_P is the only part of the masking term the P-BRDF uses (eq. 7, the projected areas
+    // cancel), once per direction in its denominator: the factor I_exact / I_approx is how
+    // much brighter (> 1) the approximation makes one direction's reflection, its inverse
+    // how much darker. Over 256² maps of every kind, three footprint centres, σ from half a
+    // texel to 32 texels, θ 0–85° at four azimuths; the approximate term (≤ 16 mip blocks)
+    // and, for comparison, the exact sum with a budget of 64 (docs/glints.md).
+    let size = 256;
+    let mut table = Vec::new();
+    for (name, budget) in [
+        ("approx (16 blocks)", None),
+        ("exact, masking_lobes = 64", Some(64)),
+    ] {
+        // [brighter, darker] × [θ ≤ 70°, 80–85°], and the mean lobe count.
+        let mut worst = [[1.0f64; 2]; 2];
+        let (mut lobes, mut n) = (0, 0);
+        for kind in KINDS {
+            let surf = surface(kind, size, 0.01);
+            for sigma in [0.5, 1.0, 2.0, 4.0, 8.0, 32.0] {
+                for c in [(100.5, 30.5), (17.2, 200.9), (150.0, 120.3)] {
+                    let q = FootprintQuery::new(
+                        Footprint::isotropic(Vec2::new(c.0, c.1), sigma),
+                        size,
+                        size,
+                    );
+                    let ex = PatchMasking::exact(&surf, &q, 0);
+                    let ap = match budget {
+                        None => PatchMasking::approx(&surf, &q),
+                        Some(b) => PatchMasking::exact(&surf, &q, b),
+                    };
+                    lobes += ap.lobe_count();
+                    n += 1;
+                    for deg in [0.0f64, 30.0, 45.0, 60.0, 70.0, 80.0, 85.0] {
+                        for phi in [0.0, 0.9, 2.0, 4.0] {
+                            let v = spherical_direction(deg.to_radians(), phi);
+                            let (ie, ia) =
+                                (ex.visible_projected_area(v), ap.visible_projected_area(v));
+                            assert!(ie > 0.0 && ia > 0.0, "{ie} {ia}");
+                            let k = (deg > 70.0) as usize;
+                            worst[0][k] = worst[0][k].max(ie / ia);
+                            worst[1][k] = worst[1][k].max(ia / ie);
+                        }
+                    }
+                }
+            }
+        }
+        println!(
+            "{name}: brighter by up to {:.3} (θ ≤ 70°) / {:.3} (80–85°), darker by up to {:.3} / {:.3}; {:.1} lobes a footprint on average",
+            worst[0][0],
+            worst[0][1],
+            worst[1][0],
+            worst[1][1],
+            lobes as f64 / n as f64
+        );
+        table.push(worst);
+    }
+    // Regression bounds a little above the measured values (docs/glints.md).
+    let [approx, budget64] = [table[0], table[1]];
+    assert!(approx[0][0] < 1.6 && approx[1][0] < 6.0, "{approx:?}");
+    assert!(budget64[0][0] < 1.1 && budget64[1][0] < 1.2, "{budget64:?}");
+    assert!(
+        budget64[0][1] < 1.15 && budget64[1][1] < 1.6,
+        "{budget64:?}"
+    );
+}
+
+#[test]
 fn approximate_masking_is_bounded_at_grazing_views() {
     // I_P is the P-BRDF's denominator: the sampler's weight F (o·h) cos θ_i /
     // (I_P(o) I_P(i) cos θ_h) (F = 1) at grazing views, over footprints of 0.1–3 texels on
