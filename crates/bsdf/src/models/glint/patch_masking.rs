@@ -20,8 +20,9 @@
 //! moment-matched lobe weighted by its area — exact at level 0, an approximation beyond
 //! (measured in the tests and docs/glints.md).
 //!
-//! **Approximate** (`masking = "approx"`, after §4.2.2): the same sum over the blocks of
-//! the mip level at which the footprint spans at most [`APPROX_BLOCKS`] of them, each
+//! **Approximate** (`masking = "approx"`, after §4.2.2): the exact term with a budget of
+//! [`APPROX_BLOCKS`] — the sum over the blocks of the mip level at which the footprint
+//! spans at most that many (the seeds themselves for the smallest footprints), each
 //! block one Beckmann lobe with the W-weighted moments of its seeds — CCM19's filtered
 //! lobe taken per block, not once for the whole footprint. A query costs at most a few
 //! lane groups (two for 16 blocks).
@@ -363,11 +364,14 @@ impl PatchMasking {
     }
 
     /// CCM19 §4.2.2 per block: the moment-matched lobes of the at most [`APPROX_BLOCKS`]
-    /// blocks of the footprint's level (module notes).
+    /// blocks of the footprint's level (module notes) — the exact sum with that budget.
+    /// At level 0 the lobes are therefore read a leaf block half at a time, as the exact
+    /// term's, not through each seed's moments.
     pub fn approx(surface: &GlintSurface, query: &FootprintQuery) -> Self {
-        let level = choose_level(surface, query, APPROX_BLOCKS);
-        let (lanes, total) = block_lanes(surface, query, level);
-        Self::normalized(MaskingMode::Approx, lanes, total, level)
+        PatchMasking {
+            mode: MaskingMode::Approx,
+            ..Self::exact(surface, query, APPROX_BLOCKS as usize)
+        }
     }
 
     /// The term with its weights divided by their sum. A footprint whose truncation holds
