@@ -226,16 +226,16 @@ impl PatchReflection for GlintBsdf {
         self.tint
     }
 
-    /// p̂(i) = (1 − ε) D̂(h) cos θ_h / (4 o·h) + ε cos θ_i / π (module notes).
+    /// With `mis_pdf = "filtered"`: p̂(i) = (1 − ε) D̂(h) cos θ_h / (4 o·h) + ε cos θ_i / π
+    /// (module notes).
     #[inline]
     fn proxy_pdf(&self, o: Vec3, i: Vec3, h: Vec3) -> Option<f64> {
+        if self.mis_pdf != MisPdf::Filtered {
+            return None;
+        }
         let filtered = self.filtered.get_or_init(|| self.masking.filtered_lobe());
         let lobe = filtered.d_untruncated(h) * h.z / (4.0 * o.dot(h));
         Some((1.0 - MIS_COSINE_SHARE) * lobe + MIS_COSINE_SHARE * i.z.max(0.0) / PI)
-    }
-
-    fn reports_proxy(&self) -> bool {
-        self.mis_pdf == MisPdf::Filtered
     }
 }
 
@@ -388,12 +388,7 @@ mod tests {
         for t in 0..=60 {
             for p in 0..32 {
                 let theta = (t as f64 / 60.0) * 0.5 * PI * (1.0 - 1e-9);
-                let phi = p as f64 * 2.0 * PI / 32.0;
-                let wi = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
+                let wi = crate::math::spherical_direction(theta, p as f64 * 2.0 * PI / 32.0);
                 let v = f.pdf(wo, wi, &ctx);
                 assert!(v > 0.0 && v.is_finite(), "{wi:?}: {v}");
             }

@@ -13,10 +13,9 @@
 //! for the density a sample reports, which only multiple importance sampling reads. Where
 //! the caller does not read it ([`BsdfContext::skip_sample_pdf`]) a sample reports the
 //! cosine density cos θ_i / π, positive and free (the filtered lobe the proxy below needs
-//! cost 3 % of a point-lit render, perf). A model with a cheap positive proxy density
-//! ([`PatchReflection::proxy_pdf`]) reports it always when it says so
-//! ([`PatchReflection::reports_proxy`], with [`Bsdf::pdf_is_exact`] false: MIS stays
-//! unbiased with any weights that sum to one).
+//! cost 3 % of a point-lit render, perf). A model that reports a cheap positive proxy
+//! density ([`PatchReflection::proxy_pdf`], with [`Bsdf::pdf_is_exact`] false) reports it
+//! in every context: MIS stays unbiased with any weights that sum to one.
 //!
 //! [`Bsdf::pdf_is_exact`]: crate::bsdf::Bsdf::pdf_is_exact
 //! [`BsdfContext::skip_sample_pdf`]: crate::bsdf::BsdfContext::skip_sample_pdf
@@ -40,15 +39,11 @@ pub(crate) trait PatchReflection {
     fn light_area(&self, i: Vec3) -> f64;
     fn fresnel(&self) -> &Fresnel;
     fn tint(&self) -> Spectrum;
-    /// A cheap positive density over the upper hemisphere standing in for the sampler's
-    /// D(h) cos θ_h / (4 o·h), where the model has one (module notes).
+    /// The density `sample` and `pdf` report in place of the sampler's D(h) cos θ_h /
+    /// (4 o·h), where the model reports one (for multiple importance sampling): cheap and
+    /// positive over the upper hemisphere (module notes). `None`: the sampler's own.
     fn proxy_pdf(&self, _o: Vec3, _i: Vec3, _h: Vec3) -> Option<f64> {
         None
-    }
-    /// Whether `sample` and `pdf` report [`Self::proxy_pdf`] rather than the sampler's
-    /// density (for multiple importance sampling).
-    fn reports_proxy(&self) -> bool {
-        false
     }
 }
 
@@ -109,7 +104,7 @@ pub(crate) fn sample(
     if !(cos_oh > 0.0) || !(i.dot(h) > 0.0) || !(h.z > 0.0) {
         return None;
     }
-    let pdf = match p.reports_proxy().then(|| p.proxy_pdf(o, i, h)).flatten() {
+    let pdf = match p.proxy_pdf(o, i, h) {
         Some(proxy) => proxy,
         // Nobody reads it: the cosine density, positive here (i.z > 0) and free.
         None if !pdf_read => i.z / PI,
@@ -144,7 +139,7 @@ pub(crate) fn pdf(p: &impl PatchReflection, o: Vec3, i: Vec3) -> f64 {
     if !(h.z > 0.0) || !(cos_oh > 0.0) {
         return 0.0;
     }
-    match p.reports_proxy().then(|| p.proxy_pdf(o, i, h)).flatten() {
+    match p.proxy_pdf(o, i, h) {
         Some(v) => guard(v, || format!("glint MIS proxy pdf at o = {o:?}, i = {i:?}")),
         None => sampler_pdf(p, o, i),
     }
