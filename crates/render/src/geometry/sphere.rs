@@ -30,10 +30,22 @@ use super::ray::Ray;
 use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
-use facette_bsdf::lanes::{LVec3, Mask, Real};
+use facette_bsdf::lanes::{LFrame, LVec3, Mask, Real};
 use facette_bsdf::math::warp::square_to_uniform_sphere;
-use facette_bsdf::math::Frame;
 use std::f64::consts::{PI, TAU};
+
+/// Sphere-light samples in lanes ([`Sphere::sample_from_lanes`]).
+#[derive(Clone, Copy)]
+pub struct ConeSampleLanes<R: Real> {
+    /// The lanes whose reference point is outside the sphere; the others hold no sample.
+    pub outside: R::Mask,
+    /// The point on the sphere.
+    pub point: LVec3<R>,
+    /// Its geometric normal (inward where the normals are flipped).
+    pub normal: LVec3<R>,
+    /// The density of its direction per unit solid angle.
+    pub pdf: R,
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sphere {
@@ -266,25 +278,27 @@ impl Sphere {
         (p, n, 1.0 / self.area())
     }
 
-    /// The cone of directions the sphere subtends from an outside point `p`:
-    /// `(sin² θ_max, 1 − cos θ_max)`, the latter by its Taylor series where the sphere
-    /// is small or far (`1 − cos` of a tiny angle cancels to zero); `None` from inside or
-    /// on the surface.
+    /// The cone of directions the sphere subtends from outside points `p`, in lanes: the
+    /// lanes where `p` is outside (on the surface or closer the cone would be a hemisphere
+    /// or more), `sin² θ_max` and `1 − cos θ_max`. The latter as `sin² θ_max / (1 +
+    /// cos θ_max)`, which has no cancellation where the sphere is small or far (`1 − cos`
+    /// of a tiny angle would round to zero, in f32 lanes already at `sin² θ_max` ≈ 1e-7)
+    /// and needs no series.
+    #[inline(always)]
+    fn cone_from_lanes<R: Real>(&self, p: LVec3<R>) -> (R::Mask, R, R) {
+        let dist2 = (LVec3::splat(self.center) - p).length_squared();
+        let r2 = R::splat(self.radius * self.radius);
+        let outside = dist2.gt(r2 * R::splat(1.0 + 1e-9));
+        let sin2_max = R::select(outside, r2 / dist2, R::zero());
+        let one_minus_cos_max = sin2_max / (R::one() + (R::one() - sin2_max).sqrt());
+        (outside, sin2_max, one_minus_cos_max)
+    }
+
+    /// [`cone_from_lanes`](Self::cone_from_lanes) at one point: `None` from inside or on
+    /// the surface.
     fn cone_from(&self, p: Vec3) -> Option<(f64, f64)> {
-        let dist2 = (self.center - p).length_squared();
-        let r2 = self.radius * self.radius;
-        // On the surface or closer: the cone would be a hemisphere or more.
-        if !(dist2 > r2 * (1.0 + 1e-9)) {
-            return None;
-        }
-        let sin2_max = r2 / dist2;
-        let one_minus_cos_max = if sin2_max < 1e-4 {
-            // 1 − √(1 − x) = x/2 + x²/8 + x³/16 + …; the cubic term is below 1e-13 here.
-            0.5 * sin2_max + 0.125 * sin2_max * sin2_max
-        } else {
-            1.0 - (1.0 - sin2_max).sqrt()
-        };
-        Some((sin2_max, one_minus_cos_max))
+        let (outside, sin2_max, one_minus_cos_max) = self.cone_from_lanes::<f64>(p.into());
+        outside.then_some((sin2_max, one_minus_cos_max))
     }
 
     /// A point of the sphere seen from `p`, its direction uniform in the cone the sphere
@@ -296,32 +310,49 @@ impl Sphere {
     /// cancellation a ray–sphere intersection has for far spheres (the form of pbrt-v4's
     /// `Sphere::Sample(ctx, u)`).
     pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
-        let Some((sin2_max, one_minus_cos_max)) = self.cone_from(p) else {
+        let s = self.sample_from_lanes::<f64>(p.into(), u.x, u.y);
+        if !s.outside {
             return area_sample_from(p, self.sample(u));
-        };
+        }
+        Some(ShapeSample {
+            point: s.point.into(),
+            normal: s.normal.into(),
+            pdf: s.pdf,
+        })
+    }
+
+    /// [`sample_from`](Self::sample_from)'s cone sample in lanes, its one source (the render
+    /// kernel's next-event estimation draws eight sphere-light samples at once); the lanes
+    /// where `p` is inside or on the sphere are not `outside` and hold no sample (the
+    /// caller draws those by area, lane by lane).
+    #[inline(always)]
+    pub fn sample_from_lanes<R: Real>(&self, p: LVec3<R>, u0: R, u1: R) -> ConeSampleLanes<R> {
+        let (outside, sin2_max, one_minus_cos_max) = self.cone_from_lanes(p);
         // θ uniform in solid angle: 1 − cos θ uniform in [0, 1 − cos θ_max].
-        let one_minus_cos = u.x * one_minus_cos_max;
-        let cos_theta = 1.0 - one_minus_cos;
-        let sin2_theta = one_minus_cos * (2.0 - one_minus_cos);
+        let one_minus_cos = u0 * one_minus_cos_max;
+        let cos_theta = R::one() - one_minus_cos;
+        let sin2_theta = one_minus_cos * (R::splat(2.0) - one_minus_cos);
         let cos_alpha = sin2_theta / sin2_max.sqrt()
-            + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
+            + cos_theta * (R::one() - sin2_theta / sin2_max).max(R::zero()).sqrt();
         let cos_alpha = cos_alpha.clamp(-1.0, 1.0);
-        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = (TAU * u.y).sin_cos();
-        let axis = (p - self.center).normalize();
-        let frame = Frame::from_normal(axis);
-        let outward = frame.to_world(Vec3::new(
+        let sin_alpha = (R::one() - cos_alpha * cos_alpha).max(R::zero()).sqrt();
+        let (sin_phi, cos_phi) = (R::splat(TAU) * u1).sin_cos();
+        let center = LVec3::splat(self.center);
+        let axis = (p - center).normalize();
+        let frame = LFrame::from_normal(axis);
+        let outward = frame.to_world(LVec3::new(
             sin_alpha * cos_phi,
             sin_alpha * sin_phi,
             cos_alpha,
         ));
-        let point = self.center + self.radius * outward;
+        let point = center + outward.scale(R::splat(self.radius));
         let normal = if self.flip_normals { -outward } else { outward };
-        Some(ShapeSample {
+        ConeSampleLanes {
+            outside,
             point,
             normal,
-            pdf: 1.0 / (TAU * one_minus_cos_max),
-        })
+            pdf: R::one() / (R::splat(TAU) * one_minus_cos_max),
+        }
     }
 
     /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
@@ -499,5 +530,56 @@ mod tests {
         }
         // Uniform on the sphere: the mean is the centre.
         assert!(close(mean / n as f64, s.center(), 0.02));
+    }
+
+    /// The render kernel's f32 lanes draw the same cone samples as the f64 sampler, to f32
+    /// precision: near spheres (wide cones), far and tiny ones (cones down to sin² θ_max
+    /// ≈ 1e-10, where `1 − cos θ_max` computed directly would round to zero in f32), and
+    /// points inside, which no lane samples.
+    #[test]
+    fn f32_lanes_draw_the_f64_cone_samples() {
+        use facette_bsdf::lanes::F32x8;
+        use facette_bsdf::math::rng::RandomSource;
+        let mut rng = facette_bsdf::math::rng::Pcg32::new(11, 3);
+        let cases = [
+            (Vec3::new(0.3, -0.2, 1.0), 0.5, Vec3::new(0.0, 0.0, 4.0)),
+            (Vec3::new(2.0, 1.0, -1.0), 0.25, Vec3::new(2.1, 1.0, -0.6)),
+            (
+                Vec3::new(-5.0, 3.0, 2.0),
+                0.01,
+                Vec3::new(40.0, -20.0, 15.0),
+            ),
+            (Vec3::new(1.0, 2.0, 3.0), 1e-3, Vec3::new(-60.0, 50.0, 30.0)),
+            (Vec3::ZERO, 1.0, Vec3::new(0.2, 0.1, -0.3)), // inside
+        ];
+        let mut worst = (0.0f64, 0.0f64);
+        for (flip, (c, r, p)) in cases.into_iter().enumerate() {
+            let s = Sphere::with_transform(c, r, &Transform::IDENTITY, flip % 2 == 1).unwrap();
+            for _ in 0..64 {
+                let u: [Vec2; 8] = std::array::from_fn(|_| rng.next_2d());
+                let lanes = s.sample_from_lanes(
+                    LVec3::<F32x8>::splat(p),
+                    F32x8::from_fn(|i| u[i].x),
+                    F32x8::from_fn(|i| u[i].y),
+                );
+                for (i, &ui) in u.iter().enumerate() {
+                    let scalar = s.sample_from_lanes::<f64>(p.into(), ui.x, ui.y);
+                    assert_eq!(lanes.outside.lane(i), scalar.outside);
+                    if !scalar.outside {
+                        continue;
+                    }
+                    let (q, n) = (lanes.point.lane(i), lanes.normal.lane(i));
+                    let dq = (q - Vec3::from(scalar.point)).length() / r;
+                    let dn = (n - Vec3::from(scalar.normal)).length();
+                    let dp = (lanes.pdf.lane(i) / scalar.pdf - 1.0).abs();
+                    worst = (worst.0.max(dq.max(dn)), worst.1.max(dp));
+                }
+            }
+        }
+        println!(
+            "f32 lanes against f64: point/normal {:.1e}, pdf {:.1e}",
+            worst.0, worst.1
+        );
+        assert!(worst.0 < 1e-3 && worst.1 < 1e-5, "{worst:?}");
     }
 }

@@ -709,12 +709,15 @@ impl EnvironmentMap {
         // and the position ξ inside the patch.
         let mut patch = [[0.0f64; PATCH_FIELDS]; MAX_LANES];
         debug_assert!(R::LANES <= MAX_LANES);
+        let mut us = [DVec2::ZERO; MAX_LANES];
+        let mut chosen = [false; MAX_LANES];
+        for i in 0..R::LANES {
+            us[i] = DVec2::new(u0.lane(i), u1.lane(i));
+            chosen[i] = set.lane(i);
+        }
+        let cells = self.distribution.sample_batch(&us, chosen);
         for (i, lane) in patch.iter_mut().enumerate().take(R::LANES) {
-            if !set.lane(i) {
-                continue;
-            }
-            let Some((x, j, _, f)) = self.distribution.sample(DVec2::new(u0.lane(i), u1.lane(i)))
-            else {
+            let Some((x, j, _, f)) = cells[i] else {
                 continue;
             };
             let (ra, rb, v0, dv) = patch_row(j, h);

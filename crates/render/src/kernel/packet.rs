@@ -41,6 +41,7 @@
 use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
 use crate::geometry::ray::offset_origin_lanes;
+use crate::geometry::shape::Shape;
 use crate::geometry::{HitLanes, LaneRays, PacketHit, RayDifferential, Vec3};
 use crate::image::ConstantEnvironment;
 use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
@@ -1129,6 +1130,34 @@ impl<'s> Kernel<'s> {
         let mut sampled: Lanes = 0;
         let mut todo = chosen;
         let one_light = !selector.reads_selection_number();
+        // A light's samples drawn lane by lane in f64 (the lights without a lane form, and a
+        // sphere light's lanes inside it).
+        macro_rules! sample_lane_by_lane {
+            ($light:expr, $lanes:expr) => {
+                for i in lanes_of($lanes) {
+                    let u = crate::geometry::Vec2::new(u0.lane(i), u1.lane(i));
+                    let p = hl.p.lane(i);
+                    let Some(ls) = $light.sample(&scene.geometry, p, u) else {
+                        continue;
+                    };
+                    if ls.radiance.is_black() {
+                        continue;
+                    }
+                    // The shadow ray offset for the lanes' precision.
+                    let shadow = ls.shadow.ray::<G>(p, hl.ng.lane(i));
+                    wi.set_lane(i, ls.wi);
+                    shadow_o.set_lane(i, shadow.origin);
+                    shadow_d.set_lane(i, shadow.dir);
+                    shadow_t.set_lane(i, shadow.t_max);
+                    rgb_set(&mut le, i, ls.radiance);
+                    pdf_light.set_lane(i, ls.pdf);
+                    if ls.delta {
+                        delta |= 1 << i;
+                    }
+                    sampled |= 1 << i;
+                }
+            };
+        }
         while todo != 0 {
             let k = light_of[todo.trailing_zeros() as usize];
             let group = if one_light {
@@ -1203,30 +1232,51 @@ impl<'s> Kernel<'s> {
                     pdf_light = merge(ok, s.pdf, pdf_light);
                     sampled |= ok;
                 }
-                light => {
-                    for i in lanes_of(group) {
-                        let u = crate::geometry::Vec2::new(u0.lane(i), u1.lane(i));
-                        let p = hl.p.lane(i);
-                        let Some(ls) = light.sample(&scene.geometry, p, u) else {
-                            continue;
-                        };
-                        if ls.radiance.is_black() {
-                            continue;
-                        }
-                        // The shadow ray offset for the lanes' precision.
-                        let shadow = ls.shadow.ray::<G>(p, hl.ng.lane(i));
-                        wi.set_lane(i, ls.wi);
-                        shadow_o.set_lane(i, shadow.origin);
-                        shadow_d.set_lane(i, shadow.dir);
-                        shadow_t.set_lane(i, shadow.t_max);
-                        rgb_set(&mut le, i, ls.radiance);
-                        pdf_light.set_lane(i, ls.pdf);
-                        if ls.delta {
-                            delta |= 1 << i;
-                        }
-                        sampled |= 1 << i;
+                light @ Light::Area {
+                    shape,
+                    radiance,
+                    two_sided,
+                } if matches!(scene.geometry.shape(*shape), Some(Shape::Sphere(_))) => {
+                    let Some(Shape::Sphere(sphere)) = scene.geometry.shape(*shape) else {
+                        unreachable!("the guard matched a sphere");
+                    };
+                    // `Light::sample` of an area light, the sphere's cone sample in lanes.
+                    let s = sphere.sample_from_lanes(hl.p, conv::<S, G>(u0), conv::<S, G>(u1));
+                    let cone = group & set_of(s.outside);
+                    sample_lane_by_lane!(light, group & !cone);
+                    let d = s.point - hl.p;
+                    let dist = d.length_squared().sqrt();
+                    let dir = d.scale(G::one() / dist);
+                    let cos_l = s.normal.dot(-dir);
+                    let faces = if *two_sided {
+                        cos_l.abs().gt(G::splat(1e-12))
+                    } else {
+                        cos_l.gt(G::splat(1e-12))
+                    };
+                    let valid = s.pdf.gt(G::zero()) & s.pdf.is_finite() & dist.gt(G::zero());
+                    let ok = if radiance.is_black() {
+                        0
+                    } else {
+                        cone & set_of(valid & faces)
+                    };
+                    // ShadowEnd::Surface: both ends offset, each towards the other.
+                    let o = offset_origin_lanes(hl.p, hl.ng, d);
+                    let seg = offset_origin_lanes(s.point, s.normal, -d) - o;
+                    let len = seg.length_squared().sqrt();
+                    let seg_ok = len.gt(G::zero()) & len.is_finite();
+                    let m = mask::<G>(ok);
+                    wi = LVec3::select(m, dir, wi);
+                    shadow_o = LVec3::select(m, o, shadow_o);
+                    shadow_d = LVec3::select(m, seg.scale(G::one() / len), shadow_d);
+                    shadow_t = G::select(m, G::select(seg_ok, len, G::zero()), shadow_t);
+                    let radiance = rgb_splat::<S>(*radiance);
+                    for ch in 0..3 {
+                        le[ch] = merge(ok, radiance[ch], le[ch]);
                     }
+                    pdf_light = merge(ok, conv::<G, S>(s.pdf), pdf_light);
+                    sampled |= ok;
                 }
+                light => sample_lane_by_lane!(light, group),
             }
         }
         let wi_local_g = frame.to_local(wi);

@@ -144,6 +144,38 @@ fn packet_and_scalar_kernels_render_the_same_image_under_an_environment_map() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The same scene with two sphere lights besides the rectangle: the packet kernel samples
+/// sphere lights by their cone in f32 lanes, the scalar kernel in f64. One of them overlaps
+/// the clay sphere, so some shading points lie inside it and are sampled by area, lane by
+/// lane.
+#[test]
+fn packet_and_scalar_kernels_render_the_same_image_with_sphere_lights() {
+    let text = format!(
+        "{SCENE}
+    [[objects]]
+    shape = \"sphere\"
+    center = [-0.2, 2.2, 0.6]
+    radius = 0.25
+    emission = 8.0
+    [[objects]]
+    shape = \"sphere\"
+    center = [-1.1, 1.35, -1]
+    radius = 0.2
+    emission = [6.0, 3.0, 1.0]
+"
+    );
+    let scene =
+        load_scene_str(&text, Path::new("packet-spheres.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let spheres = scene
+        .lights
+        .iter()
+        .filter(|l| matches!(l, facette_render::lights::Light::Area { shape, .. }
+            if matches!(scene.geometry.shape(*shape), Some(facette_render::geometry::shape::Shape::Sphere(_)))))
+        .count();
+    assert_eq!(spheres, 2, "the two sphere lights");
+    compare_kernels(&scene);
+}
+
 /// The two kernels' images at 32 spp: most pixels agree closely (the same paths), and every
 /// 8 × 8 block's mean within its noise.
 fn compare_kernels(scene: &Scene) {
