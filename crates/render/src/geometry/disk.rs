@@ -25,10 +25,13 @@ use super::error::GeometryResult;
 use super::interaction::{PrimHit, SurfaceHit};
 use super::planar::PlaneFrame;
 use super::ray::Ray;
-use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
+use super::solid_angle_sampling::{
+    area_to_solid_angle, area_to_solid_angle_lanes, ShapeSample, ShapeSampleLanes,
+};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
-use facette_bsdf::math::warp::square_to_disk_concentric;
+use facette_bsdf::lanes::{LVec3, Real};
+use facette_bsdf::math::warp::{square_to_disk_concentric, square_to_disk_concentric_lanes};
 use std::f64::consts::{PI, TAU};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -117,7 +120,26 @@ impl Disk {
     /// A point seen from `p`: the area sample converted to solid angle, as pbrt-v4 and
     /// Mitsuba 3 sample disks (no exact solid-angle sampler of an ellipse is known).
     pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
-        area_sample_from(p, self.sample(u))
+        self.sample_from_lanes::<f64>(p.into(), u.x, u.y).lane(0)
+    }
+
+    /// [`sample_from`](Self::sample_from) in lanes, its one source: drawn where the
+    /// density is positive (not on the disk's plane, not grazing).
+    #[inline(always)]
+    pub fn sample_from_lanes<R: Real>(&self, p: LVec3<R>, u0: R, u1: R) -> ShapeSampleLanes<R> {
+        let (x, y) = square_to_disk_concentric_lanes(u0, u1);
+        let point = self
+            .plane
+            .to_world()
+            .point_lanes(LVec3::new(x, y, R::zero()));
+        let normal = LVec3::splat(self.normal());
+        let pdf = area_to_solid_angle_lanes(1.0 / self.area, p, point, normal);
+        ShapeSampleLanes {
+            drawn: pdf.gt(R::zero()),
+            point,
+            normal,
+            pdf,
+        }
     }
 
     /// Density per unit solid angle with which [`sample_from`](Self::sample_from) at `p`
@@ -229,5 +251,64 @@ mod tests {
         // Uniform: a quarter of the area lies within half the radius.
         let frac = inner as f64 / n as f64;
         assert!((frac - 0.25).abs() < 0.015, "{frac}");
+    }
+
+    /// The render kernel's f32 lanes draw the f64 sampler's points and densities to f32
+    /// precision, near and far, on an elliptic disk (the reference points rounded to f32
+    /// for both, as the kernel's are); reference points on the disk's plane draw nothing
+    /// in either.
+    #[test]
+    fn f32_lanes_draw_the_f64_samples() {
+        use facette_bsdf::lanes::F32x8;
+        let t = Transform::translate(Vec3::new(0.5, 1.0, -2.0)).unwrap()
+            * Transform::rotate(Vec3::new(1.0, 1.0, 0.0), 35.0).unwrap()
+            * Transform::scale(Vec3::new(0.8, 0.3, 1.0)).unwrap();
+        let tilted = Disk::new(&t, false).unwrap();
+        let flat = Disk::new(&Transform::IDENTITY, true).unwrap();
+        let mut rng = Pcg32::new(4, 9);
+        let mut worst = (0.0f64, 0.0f64);
+        let cases = [
+            (&tilted, Vec3::new(0.0, 2.0, 1.0)),
+            (&tilted, Vec3::new(30.0, -12.0, 25.0)),
+            (&flat, Vec3::new(0.3, 0.2, -0.7)),
+            (&flat, Vec3::new(3.0, 2.0, 0.0)), // on the plane
+        ];
+        for (d, p) in cases {
+            let p = Vec3::from(p.as_vec3());
+            for _ in 0..64 {
+                let u: [Vec2; 8] = std::array::from_fn(|_| rng.next_2d());
+                let lanes = d.sample_from_lanes(
+                    LVec3::<F32x8>::splat(p),
+                    F32x8::from_fn(|i| u[i].x as f32 as f64),
+                    F32x8::from_fn(|i| u[i].y as f32 as f64),
+                );
+                for i in 0..8 {
+                    let ui = Vec2::new(u[i].x as f32 as f64, u[i].y as f32 as f64);
+                    let scalar = d.sample_from(p, ui);
+                    assert_eq!(lanes.lane(i).is_some(), scalar.is_some(), "{p}");
+                    let (Some(a), Some(b)) = (lanes.lane(i), scalar) else {
+                        continue;
+                    };
+                    let dq = (a.point - b.point).length();
+                    worst.0 = worst.0.max(dq.max((a.normal - b.normal).length()));
+                    worst.1 = worst.1.max((a.pdf / b.pdf - 1.0).abs());
+                }
+            }
+            if p.z == 0.0 {
+                assert!((0..8).all(|i| lanes_none(d, p, i)), "on the plane");
+            }
+        }
+        println!(
+            "f32 lanes against f64: point/normal {:.1e}, pdf {:.1e}",
+            worst.0, worst.1
+        );
+        assert!(worst.0 < 1e-5 && worst.1 < 1e-4, "{worst:?}");
+    }
+
+    fn lanes_none(d: &Disk, p: Vec3, i: usize) -> bool {
+        let u = facette_bsdf::lanes::F32x8::splat(0.3 + 0.05 * i as f64);
+        d.sample_from_lanes(LVec3::splat(p), u, u).lane(i).is_none()
+            && d.sample_from(p, Vec2::splat(0.3 + 0.05 * i as f64))
+                .is_none()
     }
 }

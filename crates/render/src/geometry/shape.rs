@@ -5,10 +5,11 @@ use super::disk::Disk;
 use super::interaction::SurfaceHit;
 use super::ray::Ray;
 use super::rectangle::Rectangle;
-use super::solid_angle_sampling::ShapeSample;
+use super::solid_angle_sampling::{ShapeSample, ShapeSampleLanes};
 use super::sphere::Sphere;
 use super::triangle_mesh::TriangleMesh;
 use super::{Vec2, Vec3};
+use facette_bsdf::lanes::{LVec3, Real};
 use std::sync::Arc;
 
 /// A shape of the scene. Meshes are shared (`Arc`) so that one loaded file can be
@@ -80,6 +81,18 @@ impl Shape {
             Shape::Rectangle(r) => r.sample_from(p, u),
             Shape::Disk(d) => d.sample_from(p, u),
             Shape::Mesh(m) => m.sample_from(p, u),
+        }
+    }
+
+    /// [`sample_from`](Self::sample_from) in lanes, for the shapes whose sampler has a lane
+    /// form (spheres, disks); the others draw no lane (their lanes are sampled one by
+    /// one, in f64).
+    #[inline(always)]
+    pub fn sample_from_lanes<R: Real>(&self, p: LVec3<R>, u0: R, u1: R) -> ShapeSampleLanes<R> {
+        match self {
+            Shape::Sphere(s) => s.sample_from_lanes(p, u0, u1),
+            Shape::Disk(d) => d.sample_from_lanes(p, u0, u1),
+            Shape::Rectangle(_) | Shape::Mesh(_) => ShapeSampleLanes::none(),
         }
     }
 

@@ -13,6 +13,7 @@
 //! reference point only, so `sample` and `pdf` always agree on it.
 
 use super::Vec3;
+use facette_bsdf::lanes::{LVec3, Mask, Real};
 
 /// Below this subtended solid angle (sr), spherical sampling gives way to area sampling.
 pub const MIN_SPHERICAL_SOLID_ANGLE: f64 = 3e-4;
@@ -37,25 +38,68 @@ pub struct ShapeSample {
     pub pdf: f64,
 }
 
+/// Shape samples from reference points in lanes ([`Shape::sample_from_lanes`](super::shape::Shape::sample_from_lanes)):
+/// the render kernel's next-event estimation draws eight at once.
+#[derive(Clone, Copy)]
+pub struct ShapeSampleLanes<R: Real> {
+    /// The lanes that hold a sample; the others are drawn lane by lane in f64
+    /// ([`ShapeSample`]), where the shape's sampler may still find one (a sphere's by area
+    /// from inside it).
+    pub drawn: R::Mask,
+    /// The point on the shape.
+    pub point: LVec3<R>,
+    /// The geometric normal a ray hitting `point` would report.
+    pub normal: LVec3<R>,
+    /// Density of the direction from the reference point to `point`, per unit solid angle.
+    pub pdf: R,
+}
+
+impl<R: Real> ShapeSampleLanes<R> {
+    /// No lane drawn (a shape without a lane sampler).
+    pub fn none() -> Self {
+        ShapeSampleLanes {
+            drawn: R::Mask::splat(false),
+            point: LVec3::zero(),
+            normal: LVec3::zero(),
+            pdf: R::zero(),
+        }
+    }
+
+    /// Lane `i` as a [`ShapeSample`], where drawn.
+    pub fn lane(&self, i: usize) -> Option<ShapeSample> {
+        self.drawn.lane(i).then(|| ShapeSample {
+            point: self.point.lane(i),
+            normal: self.normal.lane(i),
+            pdf: self.pdf.lane(i),
+        })
+    }
+}
+
 /// Converts a density per unit area at `q` (normal `nq`) into a density per unit solid
 /// angle of the direction from `p`: `pdf_A · |p − q|² / |cos θ_q|`. Zero where the
 /// conversion is undefined (`p` on the shape, a grazing direction, a zero density).
 #[inline]
 pub fn area_to_solid_angle(pdf_area: f64, p: Vec3, q: Vec3, nq: Vec3) -> f64 {
+    area_to_solid_angle_lanes::<f64>(pdf_area, p.into(), q.into(), nq.into())
+}
+
+/// [`area_to_solid_angle`] in lanes, its one source.
+#[inline(always)]
+pub fn area_to_solid_angle_lanes<R: Real>(
+    pdf_area: f64,
+    p: LVec3<R>,
+    q: LVec3<R>,
+    nq: LVec3<R>,
+) -> R {
     let d = q - p;
     let dist2 = d.length_squared();
-    if !(pdf_area > 0.0 && dist2 > 0.0) {
-        return 0.0;
-    }
     let cos = (nq.dot(d) / dist2.sqrt()).abs();
-    if !(cos > 1e-12) {
-        return 0.0;
-    }
-    let pdf = pdf_area * dist2 / cos;
-    if pdf.is_finite() {
-        pdf
+    let pdf = R::splat(pdf_area) * dist2 / cos;
+    let valid = dist2.gt(R::zero()) & cos.gt(R::splat(1e-12)) & pdf.is_finite();
+    if pdf_area > 0.0 {
+        R::masked(valid, pdf)
     } else {
-        0.0
+        R::zero()
     }
 }
 

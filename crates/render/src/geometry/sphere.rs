@@ -27,25 +27,14 @@ use super::bounds::Bounds3;
 use super::error::{GeometryError, GeometryResult};
 use super::interaction::{PrimHit, SurfaceHit};
 use super::ray::Ray;
-use super::solid_angle_sampling::{area_sample_from, area_to_solid_angle, ShapeSample};
+use super::solid_angle_sampling::{
+    area_sample_from, area_to_solid_angle, ShapeSample, ShapeSampleLanes,
+};
 use super::transform::Transform;
 use super::{Vec2, Vec3};
 use facette_bsdf::lanes::{LFrame, LVec3, Mask, Real};
 use facette_bsdf::math::warp::square_to_uniform_sphere;
 use std::f64::consts::{PI, TAU};
-
-/// Sphere-light samples in lanes ([`Sphere::sample_from_lanes`]).
-#[derive(Clone, Copy)]
-pub struct ConeSampleLanes<R: Real> {
-    /// The lanes whose reference point is outside the sphere; the others hold no sample.
-    pub outside: R::Mask,
-    /// The point on the sphere.
-    pub point: LVec3<R>,
-    /// Its geometric normal (inward where the normals are flipped).
-    pub normal: LVec3<R>,
-    /// The density of its direction per unit solid angle.
-    pub pdf: R,
-}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sphere {
@@ -311,7 +300,7 @@ impl Sphere {
     /// `Sphere::Sample(ctx, u)`).
     pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<ShapeSample> {
         let s = self.sample_from_lanes::<f64>(p.into(), u.x, u.y);
-        if !s.outside {
+        if !s.drawn {
             return area_sample_from(p, self.sample(u));
         }
         Some(ShapeSample {
@@ -323,10 +312,10 @@ impl Sphere {
 
     /// [`sample_from`](Self::sample_from)'s cone sample in lanes, its one source (the render
     /// kernel's next-event estimation draws eight sphere-light samples at once); the lanes
-    /// where `p` is inside or on the sphere are not `outside` and hold no sample (the
-    /// caller draws those by area, lane by lane).
+    /// where `p` is inside or on the sphere are not drawn (the caller draws those by area,
+    /// lane by lane).
     #[inline(always)]
-    pub fn sample_from_lanes<R: Real>(&self, p: LVec3<R>, u0: R, u1: R) -> ConeSampleLanes<R> {
+    pub fn sample_from_lanes<R: Real>(&self, p: LVec3<R>, u0: R, u1: R) -> ShapeSampleLanes<R> {
         let (outside, sin2_max, one_minus_cos_max) = self.cone_from_lanes(p);
         // θ uniform in solid angle: 1 − cos θ uniform in [0, 1 − cos θ_max].
         let one_minus_cos = u0 * one_minus_cos_max;
@@ -347,8 +336,8 @@ impl Sphere {
         ));
         let point = center + outward.scale(R::splat(self.radius));
         let normal = if self.flip_normals { -outward } else { outward };
-        ConeSampleLanes {
-            outside,
+        ShapeSampleLanes {
+            drawn: outside,
             point,
             normal,
             pdf: R::one() / (R::splat(TAU) * one_minus_cos_max),
@@ -564,8 +553,8 @@ mod tests {
                 );
                 for (i, &ui) in u.iter().enumerate() {
                     let scalar = s.sample_from_lanes::<f64>(p.into(), ui.x, ui.y);
-                    assert_eq!(lanes.outside.lane(i), scalar.outside);
-                    if !scalar.outside {
+                    assert_eq!(lanes.drawn.lane(i), scalar.drawn);
+                    if !scalar.drawn {
                         continue;
                     }
                     let (q, n) = (lanes.point.lane(i), lanes.normal.lane(i));

@@ -41,7 +41,7 @@
 use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
 use crate::geometry::ray::offset_origin_lanes;
-use crate::geometry::shape::Shape;
+use crate::geometry::solid_angle_sampling::ShapeSampleLanes;
 use crate::geometry::{HitLanes, LaneRays, PacketHit, RayDifferential, Vec3};
 use crate::image::ConstantEnvironment;
 use crate::integrator::{power_heuristic, Strategy, CAMERA_DIMENSIONS, VERTEX_DIMENSIONS};
@@ -1236,14 +1236,20 @@ impl<'s> Kernel<'s> {
                     shape,
                     radiance,
                     two_sided,
-                } if matches!(scene.geometry.shape(*shape), Some(Shape::Sphere(_))) => {
-                    let Some(Shape::Sphere(sphere)) = scene.geometry.shape(*shape) else {
-                        unreachable!("the guard matched a sphere");
+                } => {
+                    // `Light::sample` of an area light: the shape's sample in lanes where it
+                    // has a lane form, the other lanes one by one.
+                    let s = match scene.geometry.shape(*shape) {
+                        Some(shape) => {
+                            shape.sample_from_lanes(hl.p, conv::<S, G>(u0), conv::<S, G>(u1))
+                        }
+                        None => ShapeSampleLanes::none(),
                     };
-                    // `Light::sample` of an area light, the sphere's cone sample in lanes.
-                    let s = sphere.sample_from_lanes(hl.p, conv::<S, G>(u0), conv::<S, G>(u1));
-                    let cone = group & set_of(s.outside);
-                    sample_lane_by_lane!(light, group & !cone);
+                    let drawn = group & set_of(s.drawn);
+                    sample_lane_by_lane!(light, group & !drawn);
+                    if drawn == 0 {
+                        continue;
+                    }
                     let d = s.point - hl.p;
                     let dist = d.length_squared().sqrt();
                     let dir = d.scale(G::one() / dist);
@@ -1257,7 +1263,7 @@ impl<'s> Kernel<'s> {
                     let ok = if radiance.is_black() {
                         0
                     } else {
-                        cone & set_of(valid & faces)
+                        drawn & set_of(valid & faces)
                     };
                     // ShadowEnd::Surface: both ends offset, each towards the other.
                     let o = offset_origin_lanes(hl.p, hl.ng, d);

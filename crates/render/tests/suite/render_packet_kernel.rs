@@ -144,12 +144,12 @@ fn packet_and_scalar_kernels_render_the_same_image_under_an_environment_map() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The same scene with two sphere lights besides the rectangle: the packet kernel samples
-/// sphere lights by their cone in f32 lanes, the scalar kernel in f64. One of them overlaps
-/// the clay sphere, so some shading points lie inside it and are sampled by area, lane by
-/// lane.
+/// The same scene with two sphere lights and an elliptic disk light besides the rectangle:
+/// the packet kernel samples spheres (by their cone) and disks (by area) in f32 lanes, the
+/// scalar kernel in f64. One sphere overlaps the clay sphere, so some shading points lie
+/// inside it and are sampled by area, lane by lane.
 #[test]
-fn packet_and_scalar_kernels_render_the_same_image_with_sphere_lights() {
+fn packet_and_scalar_kernels_render_the_same_image_with_sphere_and_disk_lights() {
     let text = format!(
         "{SCENE}
     [[objects]]
@@ -162,17 +162,35 @@ fn packet_and_scalar_kernels_render_the_same_image_with_sphere_lights() {
     center = [-1.1, 1.35, -1]
     radius = 0.2
     emission = [6.0, 3.0, 1.0]
+    [[objects]]
+    shape = \"disk\"
+    transform = [{{ scale = [0.3, 0.2, 1] }}, {{ rotate = {{ axis = [1, 0, 0], angle = 110 }} }}, {{ translate = [1.2, 2.4, 0.8] }}]
+    emission = 5.0
 "
     );
     let scene =
         load_scene_str(&text, Path::new("packet-spheres.toml")).unwrap_or_else(|e| panic!("{e}"));
-    let spheres = scene
+    use facette_render::geometry::shape::Shape;
+    let kinds: Vec<&str> = scene
         .lights
         .iter()
-        .filter(|l| matches!(l, facette_render::lights::Light::Area { shape, .. }
-            if matches!(scene.geometry.shape(*shape), Some(facette_render::geometry::shape::Shape::Sphere(_)))))
-        .count();
-    assert_eq!(spheres, 2, "the two sphere lights");
+        .filter_map(|l| match l {
+            facette_render::lights::Light::Area { shape, .. } => {
+                match scene.geometry.shape(*shape) {
+                    Some(Shape::Sphere(_)) => Some("sphere"),
+                    Some(Shape::Disk(_)) => Some("disk"),
+                    Some(Shape::Rectangle(_)) => Some("rectangle"),
+                    _ => None,
+                }
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        kinds,
+        ["rectangle", "sphere", "sphere", "disk"],
+        "the area lights"
+    );
     compare_kernels(&scene);
 }
 
