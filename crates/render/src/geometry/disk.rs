@@ -282,8 +282,8 @@ mod tests {
                     F32x8::from_fn(|i| u[i].x as f32 as f64),
                     F32x8::from_fn(|i| u[i].y as f32 as f64),
                 );
-                for i in 0..8 {
-                    let ui = Vec2::new(u[i].x as f32 as f64, u[i].y as f32 as f64);
+                for (i, ui) in u.iter().enumerate() {
+                    let ui = Vec2::new(ui.x as f32 as f64, ui.y as f32 as f64);
                     let scalar = d.sample_from(p, ui);
                     assert_eq!(lanes.lane(i).is_some(), scalar.is_some(), "{p}");
                     let (Some(a), Some(b)) = (lanes.lane(i), scalar) else {
