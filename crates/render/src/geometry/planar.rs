@@ -8,6 +8,7 @@ use super::error::{GeometryError, GeometryResult};
 use super::ray::Ray;
 use super::transform::Transform;
 use super::{Vec2, Vec3};
+use facette_bsdf::lanes::{LVec3, Real};
 
 /// The placement of a planar shape: its object-to-world transform and what follows from
 /// it (world normal and centre).
@@ -75,16 +76,27 @@ impl PlaneFrame {
     /// the plane is z = 0, so the test is exact for rays nearly parallel to it): `t` and
     /// the object-space `(x, y)`. Rays parallel to the plane miss.
     pub fn intersect_plane(&self, ray: &Ray) -> Option<(f64, Vec2)> {
-        let o = self.to_world.inverse_point(ray.origin);
-        let d = self.to_world.inverse_vector(ray.dir);
-        if d.z == 0.0 {
-            return None;
-        }
+        let (hit, t, x, y) =
+            self.intersect_plane_lanes::<f64>(ray.origin.into(), ray.dir.into(), ray.t_max);
+        hit.then(|| (t, Vec2::new(x, y)))
+    }
+
+    /// [`intersect_plane`](Self::intersect_plane) over lanes, its one source: the lanes
+    /// that hit in `(0, t_max]`, `t` and the object-space `(x, y)`.
+    #[inline(always)]
+    pub fn intersect_plane_lanes<R: Real>(
+        &self,
+        o: LVec3<R>,
+        d: LVec3<R>,
+        t_max: R,
+    ) -> (R::Mask, R, R, R) {
+        let o = self.to_world.inverse_point_lanes(o);
+        let d = self.to_world.inverse_vector_lanes(d);
         let t = -o.z / d.z;
-        if !(t > 0.0 && t <= ray.t_max) {
-            return None;
-        }
-        Some((t, Vec2::new(o.x + t * d.x, o.y + t * d.y)))
+        // A ray parallel to the plane (d.z = 0) would get t = ±∞ or NaN: never a hit, even
+        // below an infinite t_max.
+        let hit = !d.z.eq(R::zero()) & t.gt(R::zero()) & t.le(t_max);
+        (hit, t, o.x + t * d.x, o.y + t * d.y)
     }
 
     /// `p` moved onto the plane along the normal, as Mitsuba does with its hits: spawned
@@ -92,5 +104,12 @@ impl PlaneFrame {
     #[inline]
     pub fn reproject(&self, p: Vec3) -> Vec3 {
         p + self.normal * self.normal.dot(self.center - p)
+    }
+
+    /// [`reproject`](Self::reproject) over lanes.
+    #[inline(always)]
+    pub fn reproject_lanes<R: Real>(&self, p: LVec3<R>) -> LVec3<R> {
+        let n = LVec3::splat(self.normal);
+        p + n.scale(n.dot(LVec3::splat(self.center) - p))
     }
 }

@@ -28,6 +28,7 @@ use super::solid_angle_sampling::{
 use super::spherical_rectangle::SphericalRectangle;
 use super::transform::Transform;
 use super::{Vec2, Vec3};
+use facette_bsdf::lanes::{LVec3, Real};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rectangle {
@@ -74,8 +75,37 @@ impl Rectangle {
     /// The hit in `(0, ray.t_max]`, found in object space (where the plane is z = 0);
     /// `local` is the object-space `(x, y)`.
     pub fn intersect_prim(&self, ray: &Ray) -> Option<PrimHit> {
-        let (t, local) = self.plane.intersect_plane(ray)?;
-        (local.x.abs() <= 1.0 && local.y.abs() <= 1.0).then_some(PrimHit { t, local })
+        let (hit, t, x, y) =
+            self.intersect_lanes::<f64>(ray.origin.into(), ray.dir.into(), ray.t_max);
+        hit.then(|| PrimHit {
+            t,
+            local: Vec2::new(x, y),
+        })
+    }
+
+    /// [`intersect_prim`](Self::intersect_prim) over lanes, its one source: the lanes that
+    /// hit in `(0, t_max]`, `t` and the object-space `(x, y)`.
+    #[inline(always)]
+    pub fn intersect_lanes<R: Real>(
+        &self,
+        o: LVec3<R>,
+        d: LVec3<R>,
+        t_max: R,
+    ) -> (R::Mask, R, R, R) {
+        let (hit, t, x, y) = self.plane.intersect_plane_lanes(o, d, t_max);
+        (hit & x.abs().le(R::one()) & y.abs().le(R::one()), t, x, y)
+    }
+
+    /// The hit points of rays `o + t d` (the lanes' [`surface_hit`](Self::surface_hit)
+    /// points): moved onto the plane.
+    #[inline(always)]
+    pub fn hit_points_lanes<R: Real>(&self, o: LVec3<R>, d: LVec3<R>, t: R) -> LVec3<R> {
+        self.plane.reproject_lanes(o + d.scale(t))
+    }
+
+    /// The tangents along u and v (constant over the rectangle).
+    pub fn tangents(&self) -> (Vec3, Vec3) {
+        (self.dpdu, self.dpdv)
     }
 
     pub fn surface_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {

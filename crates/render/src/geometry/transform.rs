@@ -231,22 +231,13 @@ impl Transform {
     /// [`point`](Self::point) over lanes, with glam's order of operations.
     #[inline(always)]
     pub fn point_lanes<R: Real>(&self, p: LVec3<R>) -> LVec3<R> {
-        // Functions, not closures or `array::from_fn`: those are compiled apart, with the
-        // instruction set of this generic code rather than the AVX2 kernel's, and called
-        // out of line where LLVM does not inline them (it had stopped doing so here).
-        #[inline(always)]
-        fn row<R: Real>(m: &Mat4, k: usize, p: LVec3<R>) -> R {
-            let (x, y, z, w) = (m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]);
-            ((R::splat(x) * p.x + R::splat(y) * p.y) + R::splat(z) * p.z) + R::splat(w)
-        }
-        let m = &self.m;
-        let h = [row(m, 0, p), row(m, 1, p), row(m, 2, p), row(m, 3, p)];
-        let affine = h[3].eq(R::one());
-        LVec3::new(
-            R::select(affine, h[0], h[0] / h[3]),
-            R::select(affine, h[1], h[1] / h[3]),
-            R::select(affine, h[2], h[2] / h[3]),
-        )
+        point_lanes_of(&self.m, p)
+    }
+
+    /// [`inverse_point`](Self::inverse_point) over lanes.
+    #[inline(always)]
+    pub fn inverse_point_lanes<R: Real>(&self, p: LVec3<R>) -> LVec3<R> {
+        point_lanes_of(&self.inv, p)
     }
 
     /// [`inverse_vector`](Self::inverse_vector) over lanes.
@@ -314,6 +305,27 @@ impl std::ops::Mul for Transform {
             inv: rhs.inv * self.inv,
         }
     }
+}
+
+/// `m` applied to points in lanes, divided by w where it is not 1, with glam's order of
+/// operations.
+#[inline(always)]
+fn point_lanes_of<R: Real>(m: &Mat4, p: LVec3<R>) -> LVec3<R> {
+    // Functions, not closures or `array::from_fn`: those are compiled apart, with the
+    // instruction set of this generic code rather than the AVX2 kernel's, and called
+    // out of line where LLVM does not inline them (it had stopped doing so here).
+    #[inline(always)]
+    fn row<R: Real>(m: &Mat4, k: usize, p: LVec3<R>) -> R {
+        let (x, y, z, w) = (m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]);
+        ((R::splat(x) * p.x + R::splat(y) * p.y) + R::splat(z) * p.z) + R::splat(w)
+    }
+    let h = [row(m, 0, p), row(m, 1, p), row(m, 2, p), row(m, 3, p)];
+    let affine = h[3].eq(R::one());
+    LVec3::new(
+        R::select(affine, h[0], h[0] / h[3]),
+        R::select(affine, h[1], h[1] / h[3]),
+        R::select(affine, h[2], h[2] / h[3]),
+    )
 }
 
 /// The linear part of `m` applied to lanes of vectors: x·v.x, then + y·v.y, then + z·v.z,

@@ -218,22 +218,17 @@ impl<R: Real> Closest<'_, R> {
     #[inline(always)]
     fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
         let g = self.geometry;
-        if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
-            let (hit, t) = self.rays.sphere(s, lanes, self.t);
-            if hit != 0 {
-                self.t = R::select(R::Mask::from_lane_bits(hit as u32), t, self.t);
-                for i in lanes_of(hit) {
-                    self.best[i] = PacketHit {
-                        slot: slot as u32,
-                        hit: PrimHit {
-                            t: t.lane(i),
-                            local: Vec2::ZERO,
-                        },
-                    };
-                }
-                self.found |= hit;
+        match &g.shapes[g.prims[slot].shape as usize] {
+            Shape::Sphere(s) => {
+                let (hit, t) = self.rays.sphere(s, lanes, self.t);
+                return self.keep(slot, hit, t, |_| Vec2::ZERO);
             }
-            return hit;
+            Shape::Rectangle(q) => {
+                let (m, t, x, y) = q.intersect_lanes(self.rays.o, self.rays.d, self.t);
+                let hit = m.lane_bits() as Lanes & lanes;
+                return self.keep(slot, hit, t, |i| Vec2::new(x.lane(i), y.lane(i)));
+            }
+            _ => {}
         }
         let mut found = 0;
         for i in lanes_of(lanes) {
@@ -253,6 +248,26 @@ impl<R: Real> Closest<'_, R> {
         self.found |= found;
         found
     }
+
+    /// Records the lanes of `hit` (hits of the primitive in `slot` at distances `t`,
+    /// object-space coordinates `local`) as the closest so far; returns them.
+    #[inline(always)]
+    fn keep(&mut self, slot: usize, hit: Lanes, t: R, local: impl Fn(usize) -> Vec2) -> Lanes {
+        if hit != 0 {
+            self.t = R::select(R::Mask::from_lane_bits(hit as u32), t, self.t);
+            for i in lanes_of(hit) {
+                self.best[i] = PacketHit {
+                    slot: slot as u32,
+                    hit: PrimHit {
+                        t: t.lane(i),
+                        local: local(i),
+                    },
+                };
+            }
+            self.found |= hit;
+        }
+        hit
+    }
 }
 
 /// An occlusion query in progress (see [`Closest`]).
@@ -267,8 +282,13 @@ impl<R: Real> Occluded<'_, R> {
     #[inline(always)]
     fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
         let g = self.geometry;
-        if let Shape::Sphere(s) = &g.shapes[g.prims[slot].shape as usize] {
-            return self.rays.sphere(s, lanes, self.rays.t_max).0;
+        match &g.shapes[g.prims[slot].shape as usize] {
+            Shape::Sphere(s) => return self.rays.sphere(s, lanes, self.rays.t_max).0,
+            Shape::Rectangle(q) => {
+                let (m, ..) = q.intersect_lanes(self.rays.o, self.rays.d, self.rays.t_max);
+                return m.lane_bits() as Lanes & lanes;
+            }
+            _ => {}
         }
         lanes_of(lanes).fold(0, |hit, i| {
             let ray = self.rays.ray(i);
@@ -431,6 +451,25 @@ impl SceneGeometry {
                         out.prim[i] = 0;
                         out.uv[0][i] = 0.0;
                         out.uv[1][i] = 0.0;
+                    }
+                }
+                Shape::Rectangle(q) if group.count_ones() > 1 => {
+                    // `Rectangle::surface_hit` in lanes.
+                    let m = R::Mask::from_lane_bits(group as u32);
+                    let n = LVec3::splat(q.normal());
+                    let (dpdu, dpdv) = q.tangents();
+                    out.t = R::select(m, t, out.t);
+                    out.p = LVec3::select(m, q.hit_points_lanes(rays.o, rays.d, t), out.p);
+                    out.ng = LVec3::select(m, n, out.ng);
+                    out.ns = LVec3::select(m, n, out.ns);
+                    out.dpdu = LVec3::select(m, LVec3::splat(dpdu), out.dpdu);
+                    out.dpdv = LVec3::select(m, LVec3::splat(dpdv), out.dpdv);
+                    for i in lanes_of(group) {
+                        let uv = hits[i].hit.local * 0.5 + Vec2::splat(0.5);
+                        out.shape[i] = shape;
+                        out.prim[i] = 0;
+                        out.uv[0][i] = uv.x;
+                        out.uv[1][i] = uv.y;
                     }
                 }
                 _ => {
