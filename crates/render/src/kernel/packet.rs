@@ -1130,8 +1130,9 @@ impl<'s> Kernel<'s> {
         let mut sampled: Lanes = 0;
         let mut todo = chosen;
         let one_light = !selector.reads_selection_number();
-        // A light's samples drawn lane by lane in f64 (the lights without a lane form, and a
-        // sphere light's lanes inside it).
+        // A light's samples drawn lane by lane in f64: the lights without a lane form, and
+        // the lanes an area light's shape draws nothing for in lanes (rectangles and
+        // triangles always, a sphere from inside it).
         macro_rules! sample_lane_by_lane {
             ($light:expr, $lanes:expr) => {
                 for i in lanes_of($lanes) {
