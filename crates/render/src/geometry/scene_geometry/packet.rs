@@ -1,7 +1,9 @@
 //! Ray queries for a packet of eight rays ([`Bvh::closest_hit_packet`],
-//! [`Bvh::any_hit_packet`]): spheres are tested eight lanes at a time by their one-source
-//! test ([`Sphere::intersect_lanes`] with `F64x8`: the same bits as one ray at a time),
-//! triangles, rectangles and disks lane by lane with their one-ray tests. A lane's hit is
+//! [`Bvh::any_hit_packet`]): spheres and rectangles are tested eight lanes at a time by
+//! their one-source tests ([`Sphere::intersect_lanes`],
+//! [`Rectangle::intersect_lanes`](crate::geometry::Rectangle::intersect_lanes); with
+//! `F64x8` the same bits as one ray at a time), triangles and disks lane by lane with
+//! their one-ray tests. A lane's hit is
 //! therefore the hit the one-ray query finds; only among primitives hit at exactly the
 //! same distance may the two orders pick different ones.
 
@@ -115,7 +117,8 @@ impl<R: Real> LaneRays<R> {
 /// [`packet_hit_record`](SceneGeometry::packet_hit_record) gives each lane with
 /// [`HitDetail::Shading`], sphere hits computed eight lanes at a time by their one-source
 /// record ([`Sphere::shading_hit_lanes`]; their `dpdv` and `uv` are left at zero until
-/// [`complete_hit`](SceneGeometry::complete_hit)), the other shapes lane by lane.
+/// [`complete_hit`](SceneGeometry::complete_hit)), rectangle hits eight at a time too, the
+/// other shapes lane by lane.
 #[derive(Clone, Copy, Debug)]
 pub struct HitLanes<R: Real = F64x8> {
     pub t: R,
@@ -397,8 +400,8 @@ impl SceneGeometry {
 
     /// The surface records of the hits `hits` of `rays` in the lanes `found` at the
     /// distances `t` (as [`intersect_lanes`](Self::intersect_lanes) gives them), written
-    /// into `out`: spheres
-    /// hit by several lanes eight lanes at a time, every other hit lane by lane. Only the
+    /// into `out`: spheres and rectangles hit by several lanes eight lanes at a time, every
+    /// other hit lane by lane. Only the
     /// lanes of `found` are written (and `out.lanes` set to them): the caller keeps one
     /// record across segments, neither cleared nor copied out (a `memset` and a `memcpy`
     /// of its 1.1 KB per segment before).
