@@ -107,6 +107,16 @@ fn rgb_splat<S: Real>(c: Spectrum) -> Rgb<S> {
     channels(|k| S::splat(c[k]))
 }
 
+/// The shadow ray from `o` (already offset) to `end`: its unit direction and length
+/// (`Ray::spawn_to`'s segment). A degenerate segment gets length 0, so it tests nothing.
+#[inline(always)]
+fn shadow_segment<G: Real>(o: LVec3<G>, end: LVec3<G>) -> (LVec3<G>, G) {
+    let seg = end - o;
+    let len = seg.length_squared().sqrt();
+    let seg_ok = len.gt(G::zero()) & len.is_finite();
+    (seg.scale(G::one() / len), G::select(seg_ok, len, G::zero()))
+}
+
 #[inline(always)]
 fn rgb_lane<S: Real>(c: &Rgb<S>, i: usize) -> Spectrum {
     Spectrum([c[0].lane(i), c[1].lane(i), c[2].lane(i)])
@@ -1197,14 +1207,12 @@ impl<'s> Kernel<'s> {
                     let ok = group & set_of(dist2.gt(G::zero()));
                     // Ray::spawn_to: offset towards the light, then the segment to it.
                     let o = offset_origin_lanes(hl.p, hl.ng, to);
-                    let seg = target - o;
-                    let len = seg.length_squared().sqrt();
-                    let seg_ok = len.gt(G::zero()) & len.is_finite();
+                    let (seg_d, seg_t) = shadow_segment(o, target);
                     let m = mask::<G>(ok);
                     wi = LVec3::select(m, dir, wi);
                     shadow_o = LVec3::select(m, o, shadow_o);
-                    shadow_d = LVec3::select(m, seg.scale(G::one() / len), shadow_d);
-                    shadow_t = G::select(m, G::select(seg_ok, len, G::zero()), shadow_t);
+                    shadow_d = LVec3::select(m, seg_d, shadow_d);
+                    shadow_t = G::select(m, seg_t, shadow_t);
                     let inv = conv::<G, S>(G::one() / dist2);
                     for ch in 0..3 {
                         le[ch] = merge(ok, S::splat(intensity[ch]) * inv, le[ch]);
@@ -1268,14 +1276,13 @@ impl<'s> Kernel<'s> {
                     };
                     // ShadowEnd::Surface: both ends offset, each towards the other.
                     let o = offset_origin_lanes(hl.p, hl.ng, d);
-                    let seg = offset_origin_lanes(s.point, s.normal, -d) - o;
-                    let len = seg.length_squared().sqrt();
-                    let seg_ok = len.gt(G::zero()) & len.is_finite();
+                    let (seg_d, seg_t) =
+                        shadow_segment(o, offset_origin_lanes(s.point, s.normal, -d));
                     let m = mask::<G>(ok);
                     wi = LVec3::select(m, dir, wi);
                     shadow_o = LVec3::select(m, o, shadow_o);
-                    shadow_d = LVec3::select(m, seg.scale(G::one() / len), shadow_d);
-                    shadow_t = G::select(m, G::select(seg_ok, len, G::zero()), shadow_t);
+                    shadow_d = LVec3::select(m, seg_d, shadow_d);
+                    shadow_t = G::select(m, seg_t, shadow_t);
                     let radiance = rgb_splat::<S>(*radiance);
                     for ch in 0..3 {
                         le[ch] = merge(ok, radiance[ch], le[ch]);
