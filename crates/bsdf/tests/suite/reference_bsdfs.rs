@@ -54,7 +54,63 @@ fn kelemen() {
     assert_report(&material_suite(&opts(), Some("kelemen")));
 }
 
+// IL's grid is the dearest (Monte Carlo and quadrature bodies, multiple-scattering orders):
+// split in four so the test threads share it rather than one thread waiting on it alone.
+fn il_suite(select: impl Fn(&str) -> bool) {
+    assert_report(&material_suite_matching(
+        &opts(),
+        |m| m.contains("\"il\"") && select(m),
+        None,
+    ));
+}
+
+fn il_flat(m: &str) -> bool {
+    m.contains("alpha = 0}")
+}
+
+fn il_quadrature(m: &str) -> bool {
+    m.contains("evaluation = \"quadrature\"")
+}
+
+fn il_orders(m: &str) -> bool {
+    m.contains("scattering = ")
+}
+
 #[test]
-fn interfaced_lambertian() {
-    assert_report(&material_suite(&opts(), Some("\"il\"")));
+fn interfaced_lambertian_flat() {
+    il_suite(il_flat);
+}
+
+#[test]
+fn interfaced_lambertian_rough_quadrature() {
+    il_suite(il_quadrature);
+}
+
+#[test]
+fn interfaced_lambertian_multiple_scattering_orders() {
+    il_suite(il_orders);
+}
+
+#[test]
+fn interfaced_lambertian_rough_stochastic() {
+    il_suite(|m| !il_flat(m) && !il_quadrature(m) && !il_orders(m));
+}
+
+#[test]
+fn the_four_interfaced_lambertian_tests_cover_its_grid_once() {
+    use facette_bsdf::validation::suites::material_grid;
+    let il: Vec<&str> = material_grid()
+        .into_iter()
+        .filter(|m| m.contains("\"il\""))
+        .collect();
+    let parts: [&dyn Fn(&str) -> bool; 4] = [&il_flat, &il_quadrature, &il_orders, &|m| {
+        !il_flat(m) && !il_quadrature(m) && !il_orders(m)
+    }];
+    for m in &il {
+        let n = parts.iter().filter(|p| p(m)).count();
+        assert_eq!(n, 1, "{m} is in {n} of the four IL tests");
+    }
+    for (k, p) in parts.iter().enumerate() {
+        assert!(il.iter().any(|m| p(m)), "IL part {k} selects nothing");
+    }
 }
