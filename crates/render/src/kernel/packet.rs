@@ -386,6 +386,14 @@ pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
         // SAFETY: the CPU has the features the function is compiled for.
         return unsafe { render_tile_avx2(job, sums) };
     }
+    render_tile_portable(job, sums)
+}
+
+/// [`render_tile`] in the portable build (`F32x8` array lanes), a function of its own so
+/// that the tests call this very copy: each instantiation of the kernel over array lanes
+/// costs LLVM about two minutes of the test build (docs/performance.md, "The test build").
+#[inline(never)]
+pub(crate) fn render_tile_portable(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     render_tile_lanes::<F32x8, GeometryLanes>(job, sums)
 }
 
@@ -409,7 +417,7 @@ type GeometryLanes = F32x8;
 /// [`render_tile`] with shading lanes `S` and geometry lanes `G` (8 lanes each: `F32x8`
 /// and [`GeometryLanes`] in the portable build's renders, `F32x8Avx2` for both in the AVX2
 /// build's; `F64x8` for both in the test that finds the scalar
-/// integrator's image, `F32x8` for both in the test of f32 geometry).
+/// integrator's image).
 #[inline(always)]
 pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
     job: &TileJob,
@@ -1548,16 +1556,16 @@ mod tests {
     use crate::scene::load_scene_str;
     use facette_bsdf::lanes::F64x8;
 
-    /// The kernel as a function of its own for the tests. `render_tile_lanes` is
-    /// `#[inline(always)]` (the AVX2 build needs its body compiled inside
-    /// `render_tile_avx2`); inlined into these tests' loops over samplers, estimators and
-    /// pixels, LLVM spent 12 of the crate's 13 minutes of compile rotating their loops.
+    /// The kernel in f64 lanes (shading and geometry), a function of its own for the
+    /// tests. `render_tile_lanes` is `#[inline(always)]` (the AVX2 build needs its body
+    /// compiled inside `render_tile_avx2`); inlined into these tests' loops over samplers,
+    /// estimators and pixels, LLVM spent 12 of the crate's 13 minutes of compile rotating
+    /// their loops. The tests' other renders call the library's own copies
+    /// ([`render_tile_portable`], `render_tile_avx2`): each further instantiation over
+    /// array lanes costs about two minutes of LLVM.
     #[inline(never)]
-    fn render_tile_with<S: ShadingLanes, G: Real>(
-        job: &TileJob,
-        sums: &mut Vec<PixelSums>,
-    ) -> usize {
-        render_tile_lanes::<S, G>(job, sums)
+    fn render_tile_f64(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
+        render_tile_lanes::<F64x8, F64x8>(job, sums)
     }
 
     const SCENE: &str = r#"
@@ -1673,9 +1681,9 @@ mod tests {
                 let sampler = PixelSampler::new(kind, 4, w, h, 8);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let mut lanes = Vec::new();
-                assert_eq!(render_tile_with::<F64x8, F64x8>(&job, &mut lanes), h);
+                assert_eq!(render_tile_f64(&job, &mut lanes), h);
                 let mut f32_lanes = Vec::new();
-                render_tile_with::<F32x8, GeometryLanes>(&job, &mut f32_lanes);
+                render_tile_portable(&job, &mut f32_lanes);
                 let mut worst: f64 = 0.0;
                 for y in 0..h {
                     for x in 0..w {
@@ -1701,14 +1709,16 @@ mod tests {
         }
     }
 
-    /// f32 geometry (rays, hit records and spawned origins in f32 lanes, with the f32
-    /// spawning offset) renders the image of f64 geometry: every sample, the same paths up
-    /// to where f32 rounding changes a hit, the image means within 1e-3 for every sampler
+    /// The portable build's f32 lanes (f32 shading, and f32 geometry: rays, hit records and
+    /// spawned origins, with the f32 spawning offset) render the image of f64 lanes, which
+    /// are the scalar integrator's (the test above): every sample, the same paths up to where
+    /// f32 rounding changes a hit or a choice, the image means within 1e-3 for every sampler
     /// and estimator, fewer than 5 % of the pixels off by more than 1e-2 (a sample whose path
     /// took another turn after a few refractions through the glass sphere), and no pixel NaN
-    /// or negative.
+    /// or negative. (Until 2026-12-07 this compared f32 with f64 geometry under f32 shading:
+    /// one more instantiation of the kernel, two minutes of the test build.)
     #[test]
-    fn f32_geometry_renders_the_image_of_f64_geometry() {
+    fn f32_lanes_render_the_image_of_f64_lanes() {
         let scene = load_scene_str(SCENE, std::path::Path::new("t.toml")).unwrap();
         let (w, h) = (scene.film.width, scene.film.height);
         let chunk: Vec<u32> = (0..16).collect();
@@ -1718,8 +1728,8 @@ mod tests {
                 let sampler = PixelSampler::new(kind, 9, w, h, 16);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let (mut f64_geometry, mut f32_geometry) = (Vec::new(), Vec::new());
-                render_tile_with::<F32x8, F64x8>(&job, &mut f64_geometry);
-                render_tile_with::<F32x8, F32x8>(&job, &mut f32_geometry);
+                render_tile_f64(&job, &mut f64_geometry);
+                render_tile_portable(&job, &mut f32_geometry);
                 let mean = |image: &[PixelSums]| -> [f64; 3] {
                     let mut m = [0.0; 3];
                     for p in image {
@@ -1779,7 +1789,7 @@ mod tests {
                 let sampler = PixelSampler::new(kind, 5, w, h, 8);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
                 let (mut portable, mut avx2) = (Vec::new(), Vec::new());
-                render_tile_with::<F32x8, GeometryLanes>(&job, &mut portable);
+                render_tile_portable(&job, &mut portable);
                 // SAFETY: the CPU has AVX2 and FMA (tested above).
                 unsafe { render_tile_avx2(&job, &mut avx2) };
                 assert_eq!(portable.len(), w * h);
@@ -1821,14 +1831,14 @@ mod tests {
             stop: &stop,
         };
         let mut sums = Vec::new();
-        assert_eq!(render_tile_with::<F32x8, GeometryLanes>(&job, &mut sums), 3);
+        assert_eq!(render_tile_portable(&job, &mut sums), 3);
         assert_eq!(sums.len(), 16 * 8);
         let counts = |sums: &[PixelSums]| sums.iter().map(|p| p.count()).collect::<Vec<_>>();
         let rows = |a: u32, b: u32| [vec![a; 3 * 8], vec![b; 13 * 8]].concat();
         assert_eq!(counts(&sums), rows(2, 0));
         // Three more rows before the next stop: the first three get their second pass.
         asked.set(0);
-        assert_eq!(render_tile_with::<F32x8, GeometryLanes>(&job, &mut sums), 3);
+        assert_eq!(render_tile_portable(&job, &mut sums), 3);
         assert_eq!(counts(&sums), rows(4, 0));
     }
 }
