@@ -8,7 +8,7 @@
 //! same distance may the two orders pick different ones.
 
 use super::{HitDetail, SceneGeometry};
-use crate::geometry::bvh::{lanes_of, Lanes, PacketBox, PACKET};
+use crate::geometry::bvh::{lanes_of, AnyLeafTest, ClosestLeafTest, Lanes, PacketBox, PACKET};
 use crate::geometry::interaction::{PrimHit, SurfaceHit};
 use crate::geometry::ray::Ray;
 use crate::geometry::shape::Shape;
@@ -219,7 +219,7 @@ impl<R: Real> Closest<'_, R> {
     /// Tests the primitive in `slot` for `lanes` within `(0, t]`; lowers `t` where it
     /// hits and returns those lanes.
     #[inline(always)]
-    fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
+    fn test_slot(&mut self, slot: usize, lanes: Lanes) -> Lanes {
         let g = self.geometry;
         match &g.shapes[g.prims[slot].shape as usize] {
             Shape::Sphere(s) => {
@@ -280,7 +280,18 @@ struct Occluded<'a, R: Real> {
     tri: TriangleRays,
 }
 
-impl<R: Real> Occluded<'_, R> {
+impl<R: Real> ClosestLeafTest for Closest<'_, R> {
+    #[inline(always)]
+    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]) -> Lanes {
+        let hit = self.test_slot(slot, lanes);
+        for i in lanes_of(hit) {
+            t_max[i] = self.t.lane(i);
+        }
+        hit
+    }
+}
+
+impl<R: Real> AnyLeafTest for Occluded<'_, R> {
     /// The lanes of `lanes` whose ray hits the primitive in `slot` within its limit.
     #[inline(always)]
     fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
@@ -371,20 +382,13 @@ impl SceneGeometry {
             // A scene of a few primitives: no box to test.
             Some(slots) => {
                 for slot in slots {
-                    q.test(slot, lanes);
+                    q.test_slot(slot, lanes);
                 }
             }
             None => {
                 let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
                 let mut t_max = std::array::from_fn(|i| rays.t_max.lane(i));
-                self.bvh
-                    .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
-                        let hit = q.test(slot, lanes);
-                        for i in lanes_of(hit) {
-                            t_max[i] = q.t.lane(i);
-                        }
-                        hit
-                    });
+                self.bvh.closest_hit_packet(&pb, lanes, &mut t_max, &mut q);
             }
         }
         (q.found, q.t)
@@ -515,7 +519,6 @@ impl SceneGeometry {
             rays,
             tri: TriangleRays::default(),
         };
-        let mut test = |slot, lanes| q.test(slot, lanes);
         match self.bvh.single_leaf() {
             Some(slots) => {
                 let mut left = lanes;
@@ -523,14 +526,14 @@ impl SceneGeometry {
                     if left == 0 {
                         break;
                     }
-                    left &= !test(slot, left);
+                    left &= !q.test(slot, left);
                 }
                 lanes & !left
             }
             None => {
                 let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
                 let t_max = std::array::from_fn(|i| rays.t_max.lane(i));
-                self.bvh.any_hit_packet(&pb, lanes, &t_max, test)
+                self.bvh.any_hit_packet(&pb, lanes, &t_max, &mut q)
             }
         }
     }
