@@ -231,6 +231,11 @@ impl<R: Real> Closest<'_, R> {
                 let hit = m.lane_bits() as Lanes & lanes;
                 return self.keep(slot, hit, t, |i| Vec2::new(x.lane(i), y.lane(i)));
             }
+            Shape::Disk(disk) => {
+                let (m, t, x, y) = disk.intersect_lanes(self.rays.o, self.rays.d, self.t);
+                let hit = m.lane_bits() as Lanes & lanes;
+                return self.keep(slot, hit, t, |i| Vec2::new(x.lane(i), y.lane(i)));
+            }
             _ => {}
         }
         let mut found = 0;
@@ -300,6 +305,10 @@ impl<R: Real> AnyLeafTest for Occluded<'_, R> {
             Shape::Sphere(s) => return self.rays.sphere(s, lanes, self.rays.t_max).0,
             Shape::Rectangle(q) => {
                 let (m, ..) = q.intersect_lanes(self.rays.o, self.rays.d, self.rays.t_max);
+                return m.lane_bits() as Lanes & lanes;
+            }
+            Shape::Disk(disk) => {
+                let (m, ..) = disk.intersect_lanes(self.rays.o, self.rays.d, self.rays.t_max);
                 return m.lane_bits() as Lanes & lanes;
             }
             _ => {}
