@@ -1,9 +1,10 @@
 //! Ray queries for a packet of eight rays ([`Bvh::closest_hit_packet`],
-//! [`Bvh::any_hit_packet`]): spheres and rectangles are tested eight lanes at a time by
-//! their one-source tests ([`Sphere::intersect_lanes`],
-//! [`Rectangle::intersect_lanes`](crate::geometry::Rectangle::intersect_lanes); with
-//! `F64x8` the same bits as one ray at a time), triangles and disks lane by lane with
-//! their one-ray tests. A lane's hit is
+//! [`Bvh::any_hit_packet`]): spheres, rectangles and disks are tested eight lanes at a
+//! time by their one-source tests ([`Sphere::intersect_lanes`],
+//! [`Rectangle::intersect_lanes`](crate::geometry::Rectangle::intersect_lanes),
+//! [`Disk::intersect_lanes`](crate::geometry::Disk::intersect_lanes); with `F64x8` the
+//! same bits as one ray at a time), triangles lane by lane with their one-ray test. The
+//! tests are the traversal's leaf tests ([`ClosestLeafTest`], [`AnyLeafTest`]). A lane's hit is
 //! therefore the hit the one-ray query finds; only among primitives hit at exactly the
 //! same distance may the two orders pick different ones.
 
