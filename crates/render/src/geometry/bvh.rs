@@ -81,7 +81,7 @@
 
 mod packet;
 
-pub use packet::{lanes_of, AnyLeafTest, ClosestLeafTest, Lanes, PacketBox, PACKET};
+pub use packet::{lanes_of, Lanes, PacketBox, PACKET};
 
 use super::bounds::Bounds3;
 use super::ray::Ray;

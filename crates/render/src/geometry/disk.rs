@@ -77,25 +77,8 @@ impl Disk {
     /// The hit in `(0, ray.t_max]`, found in object space; `local` is the object-space
     /// `(x, y)`.
     pub fn intersect_prim(&self, ray: &Ray) -> Option<PrimHit> {
-        let (hit, t, x, y) =
-            self.intersect_lanes::<f64>(ray.origin.into(), ray.dir.into(), ray.t_max);
-        hit.then(|| PrimHit {
-            t,
-            local: Vec2::new(x, y),
-        })
-    }
-
-    /// [`intersect_prim`](Self::intersect_prim) over lanes, its one source: the lanes that
-    /// hit in `(0, t_max]`, `t` and the object-space `(x, y)`.
-    #[inline(always)]
-    pub fn intersect_lanes<R: Real>(
-        &self,
-        o: LVec3<R>,
-        d: LVec3<R>,
-        t_max: R,
-    ) -> (R::Mask, R, R, R) {
-        let (hit, t, x, y) = self.plane.intersect_plane_lanes(o, d, t_max);
-        (hit & (x * x + y * y).le(R::one()), t, x, y)
+        let (t, local) = self.plane.intersect_plane(ray)?;
+        (local.x * local.x + local.y * local.y <= 1.0).then_some(PrimHit { t, local })
     }
 
     pub fn surface_hit(&self, ray: &Ray, hit: PrimHit, shape: u32) -> SurfaceHit {

@@ -5,8 +5,9 @@
 
 use super::bounds::Bounds3;
 use super::error::{GeometryError, GeometryResult};
+use super::ray::Ray;
 use super::transform::Transform;
-use super::Vec3;
+use super::{Vec2, Vec3};
 use facette_bsdf::lanes::{LVec3, Real};
 
 /// The placement of a planar shape: its object-to-world transform and what follows from
@@ -71,10 +72,17 @@ impl PlaneFrame {
         )
     }
 
-    /// The rays' crossings of the plane in `(0, t_max]` over lanes (`f64` for one ray),
-    /// found in object space (where the plane is z = 0, so the test is exact for rays
-    /// nearly parallel to it): the lanes that cross, `t` and the object-space `(x, y)`.
-    /// Rays parallel to the plane miss.
+    /// The ray's crossing of the plane in `(0, ray.t_max]`, found in object space (where
+    /// the plane is z = 0, so the test is exact for rays nearly parallel to it): `t` and
+    /// the object-space `(x, y)`. Rays parallel to the plane miss.
+    pub fn intersect_plane(&self, ray: &Ray) -> Option<(f64, Vec2)> {
+        let (hit, t, x, y) =
+            self.intersect_plane_lanes::<f64>(ray.origin.into(), ray.dir.into(), ray.t_max);
+        hit.then(|| (t, Vec2::new(x, y)))
+    }
+
+    /// [`intersect_plane`](Self::intersect_plane) over lanes, its one source: the lanes
+    /// that hit in `(0, t_max]`, `t` and the object-space `(x, y)`.
     #[inline(always)]
     pub fn intersect_plane_lanes<R: Real>(
         &self,

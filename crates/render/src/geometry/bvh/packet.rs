@@ -17,27 +17,6 @@ use std::mem::MaybeUninit;
 /// Rays per packet.
 pub const PACKET: usize = 8;
 
-/// The primitive test of a closest-hit packet query ([`Bvh::closest_hit_packet`]):
-/// `test(slot, lanes, t_max)` intersects the primitive in `slot` with the rays of `lanes`
-/// restricted to `(0, t_max[i]]`, lowers `t_max[i]` for each lane it hits (keeping the hit
-/// itself), and returns those lanes.
-///
-/// A trait with an `#[inline(always)]` implementation rather than a closure: a closure's
-/// body is a function of its own, which does not inherit the caller's target features, so
-/// that when LLVM declined to inline it into the AVX2 kernel (its inlining budget, once the
-/// tests grew) it was compiled without AVX2, with every lane operation a call
-/// (docs/performance.md, "disks intersected in lanes").
-pub trait ClosestLeafTest {
-    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]) -> Lanes;
-}
-
-/// The primitive test of an occlusion packet query ([`Bvh::any_hit_packet`]):
-/// `test(slot, lanes)` returns the lanes among `lanes` whose ray hits the primitive in
-/// `slot` within its limit. A trait for the reason [`ClosestLeafTest`] is one.
-pub trait AnyLeafTest {
-    fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes;
-}
-
 /// A set of lanes, lane `i` in bit `i`.
 pub type Lanes = u8;
 
@@ -183,16 +162,17 @@ impl PacketEntry {
 }
 
 impl Bvh {
-    /// Closest hits of the rays of `lanes` in `pb`, the primitives tested by `test`
-    /// ([`ClosestLeafTest`]). Children are visited nearest-first by their lanes' smallest
-    /// entry distance.
+    /// Closest hits of the rays of `lanes` in `pb`. `test(slot, lanes, t_max)` intersects
+    /// the primitive in `slot` with the rays of `lanes` restricted to `(0, t_max[i]]`,
+    /// lowers `t_max[i]` for each lane it hits (keeping the hit itself), and returns those
+    /// lanes. Children are visited nearest-first by their lanes' smallest entry distance.
     #[inline(always)]
     pub fn closest_hit_packet(
         &self,
         pb: &PacketBox,
         lanes: Lanes,
         t_max: &mut [f64; PACKET],
-        test: &mut impl ClosestLeafTest,
+        mut test: impl FnMut(usize, Lanes, &mut [f64; PACKET]) -> Lanes,
     ) {
         if self.nodes.is_empty() || lanes == 0 {
             return;
@@ -250,7 +230,7 @@ impl Bvh {
             } else {
                 let first = cur.index as usize;
                 for slot in first..first + cur.count as usize {
-                    for i in lanes_of(test.test(slot, cur.lanes, t_max)) {
+                    for i in lanes_of(test(slot, cur.lanes, t_max)) {
                         limit[i] = pb.limit(i, t_max[i]);
                     }
                 }
@@ -276,16 +256,16 @@ impl Bvh {
         }
     }
 
-    /// Which rays of `lanes` hit anything in `(0, t_max[i]]`, the primitives tested by
-    /// `test` ([`AnyLeafTest`]); a lane stops at its first hit, the traversal when every
-    /// lane has stopped.
+    /// Which rays of `lanes` hit anything in `(0, t_max[i]]`. `test(slot, lanes)` returns
+    /// the lanes among `lanes` whose ray hits the primitive in `slot`; a lane stops at its
+    /// first hit, the traversal when every lane has stopped.
     #[inline(always)]
     pub fn any_hit_packet(
         &self,
         pb: &PacketBox,
         lanes: Lanes,
         t_max: &[f64; PACKET],
-        test: &mut impl AnyLeafTest,
+        mut test: impl FnMut(usize, Lanes) -> Lanes,
     ) -> Lanes {
         if self.nodes.is_empty() || lanes == 0 {
             return 0;
@@ -335,7 +315,7 @@ impl Bvh {
                     if live == 0 {
                         break;
                     }
-                    active &= !test.test(slot, live);
+                    active &= !test(slot, live);
                     if active == 0 {
                         return lanes;
                     }

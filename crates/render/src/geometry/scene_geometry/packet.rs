@@ -1,15 +1,14 @@
 //! Ray queries for a packet of eight rays ([`Bvh::closest_hit_packet`],
-//! [`Bvh::any_hit_packet`]): spheres, rectangles and disks are tested eight lanes at a
-//! time by their one-source tests ([`Sphere::intersect_lanes`],
-//! [`Rectangle::intersect_lanes`](crate::geometry::Rectangle::intersect_lanes),
-//! [`Disk::intersect_lanes`](crate::geometry::Disk::intersect_lanes); with `F64x8` the
-//! same bits as one ray at a time), triangles lane by lane with their one-ray test. The
-//! tests are the traversal's leaf tests ([`ClosestLeafTest`], [`AnyLeafTest`]). A lane's hit is
+//! [`Bvh::any_hit_packet`]): spheres and rectangles are tested eight lanes at a time by
+//! their one-source tests ([`Sphere::intersect_lanes`],
+//! [`Rectangle::intersect_lanes`](crate::geometry::Rectangle::intersect_lanes); with
+//! `F64x8` the same bits as one ray at a time), triangles and disks lane by lane with
+//! their one-ray tests. A lane's hit is
 //! therefore the hit the one-ray query finds; only among primitives hit at exactly the
 //! same distance may the two orders pick different ones.
 
 use super::{HitDetail, SceneGeometry};
-use crate::geometry::bvh::{lanes_of, AnyLeafTest, ClosestLeafTest, Lanes, PacketBox, PACKET};
+use crate::geometry::bvh::{lanes_of, Lanes, PacketBox, PACKET};
 use crate::geometry::interaction::{PrimHit, SurfaceHit};
 use crate::geometry::ray::Ray;
 use crate::geometry::shape::Shape;
@@ -220,7 +219,7 @@ impl<R: Real> Closest<'_, R> {
     /// Tests the primitive in `slot` for `lanes` within `(0, t]`; lowers `t` where it
     /// hits and returns those lanes.
     #[inline(always)]
-    fn test_slot(&mut self, slot: usize, lanes: Lanes) -> Lanes {
+    fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
         let g = self.geometry;
         match &g.shapes[g.prims[slot].shape as usize] {
             Shape::Sphere(s) => {
@@ -229,11 +228,6 @@ impl<R: Real> Closest<'_, R> {
             }
             Shape::Rectangle(q) => {
                 let (m, t, x, y) = q.intersect_lanes(self.rays.o, self.rays.d, self.t);
-                let hit = m.lane_bits() as Lanes & lanes;
-                return self.keep(slot, hit, t, |i| Vec2::new(x.lane(i), y.lane(i)));
-            }
-            Shape::Disk(disk) => {
-                let (m, t, x, y) = disk.intersect_lanes(self.rays.o, self.rays.d, self.t);
                 let hit = m.lane_bits() as Lanes & lanes;
                 return self.keep(slot, hit, t, |i| Vec2::new(x.lane(i), y.lane(i)));
             }
@@ -286,18 +280,7 @@ struct Occluded<'a, R: Real> {
     tri: TriangleRays,
 }
 
-impl<R: Real> ClosestLeafTest for Closest<'_, R> {
-    #[inline(always)]
-    fn test(&mut self, slot: usize, lanes: Lanes, t_max: &mut [f64; PACKET]) -> Lanes {
-        let hit = self.test_slot(slot, lanes);
-        for i in lanes_of(hit) {
-            t_max[i] = self.t.lane(i);
-        }
-        hit
-    }
-}
-
-impl<R: Real> AnyLeafTest for Occluded<'_, R> {
+impl<R: Real> Occluded<'_, R> {
     /// The lanes of `lanes` whose ray hits the primitive in `slot` within its limit.
     #[inline(always)]
     fn test(&mut self, slot: usize, lanes: Lanes) -> Lanes {
@@ -306,10 +289,6 @@ impl<R: Real> AnyLeafTest for Occluded<'_, R> {
             Shape::Sphere(s) => return self.rays.sphere(s, lanes, self.rays.t_max).0,
             Shape::Rectangle(q) => {
                 let (m, ..) = q.intersect_lanes(self.rays.o, self.rays.d, self.rays.t_max);
-                return m.lane_bits() as Lanes & lanes;
-            }
-            Shape::Disk(disk) => {
-                let (m, ..) = disk.intersect_lanes(self.rays.o, self.rays.d, self.rays.t_max);
                 return m.lane_bits() as Lanes & lanes;
             }
             _ => {}
@@ -392,13 +371,20 @@ impl SceneGeometry {
             // A scene of a few primitives: no box to test.
             Some(slots) => {
                 for slot in slots {
-                    q.test_slot(slot, lanes);
+                    q.test(slot, lanes);
                 }
             }
             None => {
                 let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
                 let mut t_max = std::array::from_fn(|i| rays.t_max.lane(i));
-                self.bvh.closest_hit_packet(&pb, lanes, &mut t_max, &mut q);
+                self.bvh
+                    .closest_hit_packet(&pb, lanes, &mut t_max, |slot, lanes, t_max| {
+                        let hit = q.test(slot, lanes);
+                        for i in lanes_of(hit) {
+                            t_max[i] = q.t.lane(i);
+                        }
+                        hit
+                    });
             }
         }
         (q.found, q.t)
@@ -529,6 +515,7 @@ impl SceneGeometry {
             rays,
             tri: TriangleRays::default(),
         };
+        let mut test = |slot, lanes| q.test(slot, lanes);
         match self.bvh.single_leaf() {
             Some(slots) => {
                 let mut left = lanes;
@@ -536,14 +523,14 @@ impl SceneGeometry {
                     if left == 0 {
                         break;
                     }
-                    left &= !q.test(slot, left);
+                    left &= !test(slot, left);
                 }
                 lanes & !left
             }
             None => {
                 let pb = PacketBox::new(&LaneRays::axes(&rays.o), &LaneRays::axes(&rays.d));
                 let t_max = std::array::from_fn(|i| rays.t_max.lane(i));
-                self.bvh.any_hit_packet(&pb, lanes, &t_max, &mut q)
+                self.bvh.any_hit_packet(&pb, lanes, &t_max, test)
             }
         }
     }
