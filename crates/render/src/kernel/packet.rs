@@ -1727,9 +1727,9 @@ mod tests {
             for strategy in [Strategy::Mis, Strategy::NeeOnly, Strategy::BsdfOnly] {
                 let sampler = PixelSampler::new(kind, 9, w, h, 16);
                 let job = whole_frame(&scene, &sampler, strategy, &chunk, &never);
-                let (mut f64_geometry, mut f32_geometry) = (Vec::new(), Vec::new());
-                render_tile_f64(&job, &mut f64_geometry);
-                render_tile_portable(&job, &mut f32_geometry);
+                let (mut f64_lanes, mut f32_lanes) = (Vec::new(), Vec::new());
+                render_tile_f64(&job, &mut f64_lanes);
+                render_tile_portable(&job, &mut f32_lanes);
                 let mean = |image: &[PixelSums]| -> [f64; 3] {
                     let mut m = [0.0; 3];
                     for p in image {
@@ -1742,7 +1742,7 @@ mod tests {
                     }
                     m
                 };
-                let (a, b) = (mean(&f64_geometry), mean(&f32_geometry));
+                let (a, b) = (mean(&f64_lanes), mean(&f32_lanes));
                 for c in 0..3 {
                     let rel = (a[c] - b[c]).abs() / a[c];
                     assert!(
@@ -1752,9 +1752,9 @@ mod tests {
                 }
                 // Rounding differences grow through the glass sphere's refractions to 1e-4;
                 // a pixel off by more than 1e-2 has a sample whose path took another turn.
-                let differ = f64_geometry
+                let differ = f64_lanes
                     .iter()
-                    .zip(&f32_geometry)
+                    .zip(&f32_lanes)
                     .filter(|(p, q)| {
                         let (a, b) = (p.sums(), q.sums());
                         (0..3).any(|c| (a[c] - b[c]).abs() > 1e-2 * a[c].max(1e-2))
