@@ -509,317 +509,64 @@ impl Bits32 for U32x8Avx2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lanes::{F32x8, U32x8};
+    use crate::lanes::register_lane_tests as check;
 
-    /// Values with every kind of edge: signed zeros, subnormals, infinities, NaN, integers
-    /// and halves, the Cephes functions' ranges, and pseudo-random bits.
-    fn values() -> Vec<f32> {
-        let mut v = vec![
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            0.5,
-            -0.5,
-            1.5,
-            -2.5,
-            1e-40,
-            -1e-40,
-            1e-30,
-            f32::MIN_POSITIVE,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            3.0e7,
-            -88.0,
-            89.0,
-            6.2,
-            100.0,
-        ];
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        for k in 0..4000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let bits = (state >> 32) as u32;
-            v.push(match k % 3 {
-                0 => f32::from_bits(bits),
-                1 => (bits >> 8) as f32 / 16_777_216.0 * 20.0 - 10.0,
-                _ => (bits >> 8) as f32 / 16_777_216.0 * 200.0 - 100.0,
-            });
+    /// Whether the checks can run here (they are skipped, saying so, on a CPU without AVX2).
+    fn runs_here() -> bool {
+        let yes = available();
+        if !yes {
+            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
         }
-        v
+        yes
     }
 
-    fn chunks(v: &[f32]) -> Vec<[f32; 8]> {
-        v.chunks(8)
-            .map(|c| std::array::from_fn(|i| c[i % c.len()]))
-            .collect()
-    }
-
-    fn same(a: F32x8, b: F32x8Avx2, what: &str, x: [f32; 8]) {
-        let (a, b) = (a.0, b.to_array());
-        for i in 0..8 {
-            // NaN payloads may differ between the scalar and vector forms of an operation.
-            let ok = a[i].to_bits() == b[i].to_bits() || (a[i].is_nan() && b[i].is_nan());
-            assert!(
-                ok,
-                "{what} of {:e}: array {:e}, avx2 {:e}",
-                x[i], a[i], b[i]
-            );
-        }
-    }
-
-    /// Every operation of the register lanes gives the array lanes' bits, on edge values and
-    /// random ones, in pairs shifted against each other.
     #[test]
     fn register_lanes_compute_the_array_lanes_bits() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
+        if runs_here() {
+            check::float_operations_compute_the_array_lanes_bits::<crate::lanes::F32x8, F32x8Avx2>(
+            );
         }
-        let v = values();
-        let xs = chunks(&v);
-        let ys = chunks(&v[3..]);
-        for (x, y) in xs.iter().zip(&ys) {
-            let (a, b) = (F32x8(*x), F32x8(*y));
-            let (p, q) = (F32x8Avx2::from_array(*x), F32x8Avx2::from_array(*y));
-            same(a + b, p + q, "add", *x);
-            same(a - b, p - q, "sub", *x);
-            same(a * b, p * q, "mul", *x);
-            same(a / b, p / q, "div", *x);
-            same(-a, -p, "neg", *x);
-            same(a.sqrt(), p.sqrt(), "sqrt", *x);
-            same(a.abs(), p.abs(), "abs", *x);
-            same(a.min(b), p.min(q), "min", *x);
-            same(a.max(b), p.max(q), "max", *x);
-            same(a.floor(), p.floor(), "floor", *x);
-            same(a.exp(), p.exp(), "exp", *x);
-            same(a.ln(), p.ln(), "ln", *x);
-            let (s, c) = a.sin_cos();
-            let (s2, c2) = p.sin_cos();
-            same(s, s2, "sin", *x);
-            same(c, c2, "cos", *x);
-            same(a.clamp(-2.0, 3.0), p.clamp(-2.0, 3.0), "clamp", *x);
-            for (m, n, what) in [
-                (a.lt(b), p.lt(q), "lt"),
-                (a.le(b), p.le(q), "le"),
-                (a.gt(b), p.gt(q), "gt"),
-                (a.ge(b), p.ge(q), "ge"),
-                (a.eq(b), p.eq(q), "eq"),
-                (a.is_finite(), p.is_finite(), "is_finite"),
-            ] {
-                assert_eq!(m.lane_bits(), n.lane_bits(), "{what} of {x:?}, {y:?}");
-                same(F32x8::select(m, a, b), F32x8Avx2::select(n, p, q), what, *x);
-                assert_eq!((!m).lane_bits(), (!n).lane_bits());
-                let other = a.lt(F32x8::zero());
-                let other2 = p.lt(F32x8Avx2::zero());
-                assert_eq!((m & other).lane_bits(), (n & other2).lane_bits());
-                assert_eq!((m | other).lane_bits(), (n | other2).lane_bits());
-                assert_eq!(
-                    M32x8Avx2::from_lane_bits(n.lane_bits()).lane_bits(),
-                    n.lane_bits()
-                );
-                for i in 0..8 {
-                    assert_eq!(m.lane(i), n.lane(i));
-                }
-            }
-        }
-        assert!(M32x8Avx2::splat(true).all() && M32x8Avx2::splat(false).none());
-        let mut p = F32x8Avx2::splat(1.0);
-        p.set_lane(5, 7.0);
-        assert_eq!(p.to_array(), [1.0, 1.0, 1.0, 1.0, 1.0, 7.0, 1.0, 1.0]);
-        assert_eq!(F32x8Avx2::from_fn(|i| i as f64).lane(6), 6.0);
     }
 
     #[test]
     fn register_integers_compute_the_array_integers_bits() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
-        }
-        let v: Vec<u32> = values().iter().map(|x| x.to_bits()).collect();
-        for (x, y) in v.chunks_exact(8).zip(v[5..].chunks_exact(8)) {
-            let x: [u32; 8] = x.try_into().unwrap();
-            let y: [u32; 8] = y.try_into().unwrap();
-            let (a, b) = (U32x8(x), U32x8(y));
-            let (p, q) = (U32x8Avx2::from_array(x), U32x8Avx2::from_array(y));
-            let pairs = [
-                (a.wrapping_add(b), p.wrapping_add(q)),
-                (a.wrapping_sub(b), p.wrapping_sub(q)),
-                (a.wrapping_mul(b), p.wrapping_mul(q)),
-                (a & b, p & q),
-                (a | b, p | q),
-                (a ^ b, p ^ q),
-                (a.shl(7), p.shl(7)),
-                (a.shr(13), p.shr(13)),
-                (a.shr_lanes(b), p.shr_lanes(q)),
-                (a.reverse(), p.reverse()),
-            ];
-            for (k, (r, s)) in pairs.iter().enumerate() {
-                assert_eq!(r.0, s.to_array(), "operation {k} of {x:?}, {y:?}");
-            }
-            assert_eq!(
-                a.unit::<F32x8>().0,
-                p.unit::<F32x8Avx2>().to_array(),
-                "unit of {x:?}"
-            );
-            let f64s: [f64; 8] = std::array::from_fn(|i| a.unit::<crate::lanes::F64x8>().0[i]);
-            assert_eq!(f64s, p.unit::<crate::lanes::F64x8>().0);
+        if runs_here() {
+            check::integer_operations_compute_the_array_integers_bits::<F32x8Avx2>();
         }
     }
 
-    /// The permutations and the bit-mask blend move the same lanes as the array lanes' (and
-    /// as the definition: lane i takes lane from[i]), with repeated and identity indices.
     #[test]
     fn register_permutes_and_blends_move_the_array_lanes() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
-        }
-        let x: [u32; 8] = [11, 22, 33, 44, 55, 66, 77, 88];
-        let y: [u32; 8] = [1, 2, 3, 4, 5, 6, 7, 8];
-        let f = x.map(|v| v as f32 * 0.5);
-        for from in [
-            [0u8, 1, 2, 3, 4, 5, 6, 7],
-            [7, 6, 5, 4, 3, 2, 1, 0],
-            [3, 3, 0, 7, 1, 1, 6, 2],
-        ] {
-            let want: [u32; 8] = std::array::from_fn(|i| x[from[i] as usize]);
-            assert_eq!(U32x8(x).permute(&from).0, want);
-            assert_eq!(U32x8Avx2::from_array(x).permute(&from).to_array(), want);
-            let wantf: [f32; 8] = std::array::from_fn(|i| f[from[i] as usize]);
-            assert_eq!(F32x8(f).permute(&from).0, wantf);
-            assert_eq!(F32x8Avx2::from_array(f).permute(&from).to_array(), wantf);
-        }
-        for set in [0u8, 0xff, 0b1010_0110, 0b0000_0001, 0b1000_0000] {
-            let want: [u32; 8] =
-                std::array::from_fn(|i| if (set >> i) & 1 != 0 { x[i] } else { y[i] });
-            assert_eq!(U32x8::blend_bits(set, U32x8(x), U32x8(y)).0, want);
-            let p = U32x8Avx2::blend_bits(set, U32x8Avx2::from_array(x), U32x8Avx2::from_array(y));
-            assert_eq!(p.to_array(), want, "set {set:08b}");
+        if runs_here() {
+            check::permutes_and_blends_move_the_array_lanes::<F32x8Avx2>();
         }
     }
 
-    /// The register lanes' 64-bit hash is `mix_seed`, bit for bit, on edge and random pairs.
     #[test]
     fn register_mix_seeds_is_mix_seed() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
-        }
-        let mut rng = crate::math::rng::Pcg32::new(7, 3);
-        let mut next = || ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
-        let edges = [
-            0,
-            1,
-            u64::MAX,
-            1 << 32,
-            (1 << 32) - 1,
-            1 << 63,
-            0x9E37_79B9_7F4A_7C15,
-        ];
-        for round in 0..64 {
-            let a: [u64; 8] = std::array::from_fn(|i| match round {
-                0 => edges[i % edges.len()],
-                _ => next(),
-            });
-            let b: [u64; 8] = std::array::from_fn(|i| match round {
-                0 => edges[(i + 3) % edges.len()],
-                _ => next(),
-            });
-            let want: [u64; 8] = std::array::from_fn(|i| crate::math::rng::mix_seed(a[i], b[i]));
-            assert_eq!(U32x8Avx2::mix_seeds(&a, &b), want, "{a:?} {b:?}");
-            assert_eq!(U32x8::mix_seeds(&a, &b), want);
+        if runs_here() {
+            check::mix_seeds_is_mix_seed::<U32x8Avx2>();
         }
     }
 
-    /// The lanes above a value, as bits, agree with the array lanes and with the definition,
-    /// across the unsigned range (the sign bit included) and at both ends of `v`.
     #[test]
     fn register_lanes_above_a_value_are_the_definitions() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
-        }
-        let lanes = [0, 1, 7, 8, 1 << 31, u32::MAX, u32::MAX - 1, 5];
-        for v in [
-            0,
-            1,
-            5,
-            7,
-            8,
-            (1 << 31) - 1,
-            1 << 31,
-            u32::MAX - 1,
-            u32::MAX,
-        ] {
-            let want = (0..8).fold(0u8, |s, i| s | ((lanes[i] > v) as u8) << i);
-            assert_eq!(U32x8Avx2::from_array(lanes).above_bits(v), want, "{v}");
-            assert_eq!(U32x8(lanes).above_bits(v), want, "{v}");
-        }
-        for (i, &l) in lanes.iter().enumerate() {
-            assert_eq!(l.above_bits(4) != 0, l > 4, "{i}");
+        if runs_here() {
+            check::lanes_above_a_value_are_the_definitions::<U32x8Avx2>();
         }
     }
 
-    /// The integer gather reads each lane's entry, the array lanes' and one `u32`'s, and an
-    /// index outside the table (by one, with the sign bit, in an empty table) panics
-    /// before anything is read.
     #[test]
     fn register_integer_gather_reads_each_lanes_entry() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
-        }
-        let table: Vec<u32> = (0..300u32).map(|k| k.wrapping_mul(0x9e37_79b9)).collect();
-        for idx in [[0, 299, 1, 298, 150, 7, 7, 0], [5, 6, 7, 8, 9, 10, 11, 12]] {
-            let a = U32x8(idx).gather(&table);
-            let p = U32x8Avx2::from_array(idx).gather(&table);
-            assert_eq!(a.0, p.to_array());
-            for i in 0..8 {
-                assert_eq!(a.0[i], table[idx[i] as usize]);
-                assert_eq!(idx[i].gather(&table), a.0[i]);
-            }
-        }
-        let seven = U32x8Avx2::from_array([0, 1, 2, 3, 4, 5, 6, 7]);
-        assert!(seven.all_below(8) && !seven.all_below(7) && !seven.all_below(0));
-        for (bad, len) in [(300, 300), (1 << 31, 300), (u32::MAX, 300), (0, 0)] {
-            let idx = U32x8Avx2::from_array([0, 1, 2, bad, 4, 5, 6, 7]);
-            let array = U32x8([0, 1, 2, bad, 4, 5, 6, 7]);
-            assert!(!idx.all_below(len as u32) && !array.all_below(len as u32));
-            let out = std::panic::catch_unwind(|| idx.gather(&table[..len]));
-            assert!(
-                out.is_err(),
-                "index {bad} of a table of {len} must not be read"
-            );
+        if runs_here() {
+            check::integer_gather_reads_each_lanes_entry::<U32x8Avx2>();
         }
     }
 
-    /// The register gather reads the same cells as the array lanes' and transposes them.
     #[test]
     fn register_gather_reads_each_lanes_cell() {
-        if !available() {
-            eprintln!("this CPU has no AVX2 + FMA: the register lanes cannot run here");
-            return;
+        if runs_here() {
+            check::gather_reads_each_lanes_cell::<crate::lanes::F32x8, F32x8Avx2>(true);
         }
-        let table = CellTable::new(
-            (0..50)
-                .map(|k| std::array::from_fn(|j| (k * 4 + j) as f64 + 0.25))
-                .collect(),
-        );
-        let cells = [0.0, 49.0, 3.7, 12.2, 7.0, 48.9, 0.5, 25.0];
-        let a = F32x8::gather4(&table, F32x8(cells));
-        let p = F32x8Avx2::gather4(&table, F32x8Avx2::from_array(cells));
-        for k in 0..4 {
-            assert_eq!(a[k].0, p[k].to_array(), "number {k}");
-        }
-        assert_eq!(p[2].lane(1), (49 * 4 + 2) as f64 + 0.25);
-        let out = std::panic::catch_unwind(|| {
-            F32x8Avx2::gather4(&table, F32x8Avx2::splat(f64::NAN));
-        });
-        assert!(out.is_err(), "a NaN cell index must not read a cell");
     }
 }
