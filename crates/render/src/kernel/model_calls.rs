@@ -12,9 +12,11 @@
 //! kernel's function they made the render crate's builds much slower (its test build
 //! about twice as long).
 
-use facette_bsdf::lanes::{Bits32, F32x8, F64x8, LVec3, Real, U32x8};
+use facette_bsdf::lanes::{Bits32, LVec3, Real};
+#[cfg(not(target_arch = "x86_64"))]
+use facette_bsdf::lanes::{F32x8, F64x8, U32x8};
 #[cfg(target_arch = "x86_64")]
-use facette_bsdf::lanes::{F32x8Avx2, U32x8Avx2};
+use facette_bsdf::lanes::{F32x8Avx2, F32x8Sse2, F64x8Sse2, U32x8Avx2, U32x8Sse2};
 use facette_bsdf::models::{ColorSource, LaneBsdf, LaneRandom, LaneSample};
 
 use crate::image::environment::{EnvSampleLanes, EnvironmentMap};
@@ -87,14 +89,28 @@ fn sample_environment_out_of_line<R: Real>(
     map.sample_lanes(u0, u1, set)
 }
 
-/// f64 lanes (the test that finds the scalar integrator's image): the baseline build.
+/// f64 array lanes (the test that finds the scalar integrator's image, off x86-64).
+#[cfg(not(target_arch = "x86_64"))]
 impl ShadingLanes for F64x8 {
     type Bits = U32x8;
 }
 
-/// f32 array lanes: the portable build's (where the CPU has no AVX2) and the tests'.
+/// f64 SSE2 register lanes (the test that finds the scalar integrator's image, on x86-64).
+#[cfg(target_arch = "x86_64")]
+impl ShadingLanes for F64x8Sse2 {
+    type Bits = U32x8Sse2;
+}
+
+/// f32 array lanes: the portable build's off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
 impl ShadingLanes for F32x8 {
     type Bits = U32x8;
+}
+
+/// f32 SSE2 register lanes: the portable build's on x86-64 (where the CPU has no AVX2).
+#[cfg(target_arch = "x86_64")]
+impl ShadingLanes for F32x8Sse2 {
+    type Bits = U32x8Sse2;
 }
 
 /// f32 register lanes (renders where the CPU has AVX2 and FMA): each model call compiled

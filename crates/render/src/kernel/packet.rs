@@ -10,8 +10,9 @@
 //! (one packet query); the materials' samples; throughput, roulette and the next rays.
 //!
 //! Everything in lanes is in f32 lanes in renders — `F32x8Avx2` (AVX registers) in the AVX2
-//! build, [`F32x8`] (arrays, the same bits) in the portable one — and in [`F64x8`] in the
-//! test that finds the scalar integrator's image sample for sample. That covers the geometry —
+//! build, [`PortableLanes`] (two SSE registers on x86-64, arrays elsewhere; the same bits)
+//! in the portable one — and in f64 lanes (`F64x8`'s bits, in SSE2 registers on x86-64) in
+//! the test that finds the scalar integrator's image sample for sample. That covers the geometry —
 //! rays, hit points, normals, frames, spawned origins, computed by the same one-source
 //! functions as the scalar integrator's (the sphere test and record, the camera, the
 //! spawning rule with the offset of the lanes' precision, the frame) — and the shading —
@@ -34,9 +35,9 @@
 //! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than environments and point lights (and
 //! maps of more than 2²⁴ pixels, which an f32 lane cannot index), area-light emission, ray
 //! differentials. On x86-64 the kernel
-//! is compiled twice, for the baseline (SSE2: an 8-lane f32 operation is two instructions)
-//! and for AVX2 + FMA with the register lanes, chosen at run time; the two give the same
-//! image bit for bit (tested).
+//! is compiled twice, for the baseline with the SSE2 register lanes (an 8-lane f32
+//! operation is two instructions) and for AVX2 + FMA with the AVX register lanes, chosen at
+//! run time; the two give the same image bit for bit (tested).
 
 use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
@@ -52,9 +53,11 @@ use crate::render::{CameraSampling, PixelSums};
 use crate::sampler::lanes::{move_lanes, SampleLanes};
 use crate::sampler::{PixelSampler, PrefixedSource, SampleStream};
 use crate::scene::Scene;
+#[cfg(not(target_arch = "x86_64"))]
+use facette_bsdf::lanes::F32x8;
+use facette_bsdf::lanes::{channels, Bits32, LFrame, LVec3, Mask, Real};
 #[cfg(target_arch = "x86_64")]
-use facette_bsdf::lanes::F32x8Avx2;
-use facette_bsdf::lanes::{channels, Bits32, F32x8, LFrame, LVec3, Mask, Real};
+use facette_bsdf::lanes::{F32x8Avx2, F32x8Sse2};
 use facette_bsdf::math::rng::RandomSource;
 use facette_bsdf::math::warp::square_to_uniform_sphere_lanes;
 use facette_bsdf::math::Frame;
@@ -389,13 +392,29 @@ pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     render_tile_portable(job, sums)
 }
 
-/// [`render_tile`] in the portable build (`F32x8` array lanes), a function of its own so
-/// that the tests call this very copy: each instantiation of the kernel over array lanes
-/// costs LLVM about two minutes of the test build (docs/performance.md, "The test build").
+/// [`render_tile`] in the portable build ([`PortableLanes`]), a function of its own so that
+/// the tests call this very copy rather than compile another.
 #[inline(never)]
 pub(crate) fn render_tile_portable(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
-    render_tile_lanes::<F32x8, GeometryLanes>(job, sums)
+    render_tile_lanes::<PortableLanes, PortableLanes>(job, sums)
 }
+
+/// The portable build's lanes, for shading and geometry alike. On x86-64 the SSE2 register
+/// lanes: over the array lanes the kernel had cost LLVM 115–146 s to compile (its SLP
+/// vectorizer searching the kernel's large functions for the array loops to fuse), in each
+/// build that holds it, and left a third of the code 4-wide and scalar (docs/performance.md,
+/// "The test build"). Elsewhere (aarch64) the array lanes, which compute the same bits.
+///
+/// Geometry (rays, hit records, spawned origins) is in f32 like the shading, as in the AVX2
+/// build, whose lanes compute the same bits: an image (and each part of a `--part K/N`
+/// run) is the same on every x86-64 CPU. f32 geometry spawns rays with the f32 offset
+/// (`geometry::ray`, tested off spheres and meshes far from the origin) and renders the
+/// image of f64 geometry within rounding (the test below). With the AVX2 register lanes it
+/// costs 1,371 instructions a bench-sphere sample against 1,741 with `F64x8` geometry.
+#[cfg(target_arch = "x86_64")]
+type PortableLanes = F32x8Sse2;
+#[cfg(not(target_arch = "x86_64"))]
+type PortableLanes = F32x8;
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
@@ -403,21 +422,9 @@ unsafe fn render_tile_avx2(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     render_tile_lanes::<F32x8Avx2, F32x8Avx2>(job, sums)
 }
 
-/// The lane type of the portable build's geometry (rays, hit records, spawned origins): f32,
-/// like its shading lanes; the AVX2 build's is `F32x8Avx2`, which computes the same bits,
-/// so that an image (and each part of a `--part K/N` run) is the same on every x86-64 CPU.
-/// f32 geometry spawns rays with the f32 offset (`geometry::ray`, tested off spheres and
-/// meshes far from the origin) and renders the image of f64 geometry within rounding (the
-/// test below). With the register lanes it costs 1,371 instructions a bench-sphere sample
-/// against 1,741 with `F64x8` geometry (two registers per value); with the array lanes it
-/// had cost more than f64, because LLVM left much of its `[f32; 8]` code 4-wide and scalar
-/// (docs/performance.md).
-type GeometryLanes = F32x8;
-
-/// [`render_tile`] with shading lanes `S` and geometry lanes `G` (8 lanes each: `F32x8`
-/// and [`GeometryLanes`] in the portable build's renders, `F32x8Avx2` for both in the AVX2
-/// build's; `F64x8` for both in the test that finds the scalar
-/// integrator's image).
+/// [`render_tile`] with shading lanes `S` and geometry lanes `G` (8 lanes each:
+/// [`PortableLanes`] for both in the portable build's renders, `F32x8Avx2` for both in the AVX2
+/// build's; f64 lanes for both in the test that finds the scalar integrator's image).
 #[inline(always)]
 pub(crate) fn render_tile_lanes<S: ShadingLanes, G: Real>(
     job: &TileJob,
@@ -1554,18 +1561,24 @@ mod tests {
     use crate::integrator::radiance;
     use crate::sampler::SamplerKind;
     use crate::scene::load_scene_str;
-    use facette_bsdf::lanes::F64x8;
+    /// The f64 lanes of the tests: on x86-64 the SSE2 register form, which computes the
+    /// array lanes' (`F64x8`, and so one `f64`'s) bits and costs LLVM a fraction of their
+    /// compile time (about 90 s for this instantiation over arrays; docs/performance.md,
+    /// "The test build").
+    #[cfg(target_arch = "x86_64")]
+    type F64Lanes = facette_bsdf::lanes::F64x8Sse2;
+    #[cfg(not(target_arch = "x86_64"))]
+    type F64Lanes = facette_bsdf::lanes::F64x8;
 
     /// The kernel in f64 lanes (shading and geometry), a function of its own for the
     /// tests. `render_tile_lanes` is `#[inline(always)]` (the AVX2 build needs its body
     /// compiled inside `render_tile_avx2`); inlined into these tests' loops over samplers,
     /// estimators and pixels, LLVM spent 12 of the crate's 13 minutes of compile rotating
     /// their loops. The tests' other renders call the library's own copies
-    /// ([`render_tile_portable`], `render_tile_avx2`): each further instantiation over
-    /// array lanes costs about two minutes of LLVM.
+    /// ([`render_tile_portable`], `render_tile_avx2`) rather than compile more.
     #[inline(never)]
     fn render_tile_f64(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
-        render_tile_lanes::<F64x8, F64x8>(job, sums)
+        render_tile_lanes::<F64Lanes, F64Lanes>(job, sums)
     }
 
     const SCENE: &str = r#"
@@ -1770,7 +1783,7 @@ mod tests {
     }
 
     /// The renders' AVX2 build, with its register lanes (`F32x8Avx2`), computes the bits of
-    /// the portable build's array lanes (`F32x8`): every pixel's sums, for every sampler and
+    /// the portable build's SSE2 lanes (`F32x8Sse2`): every pixel's sums, for every sampler and
     /// estimator, on a scene with every lane model, textures, both distributions, a
     /// conductor's complex Fresnel, glass, an area light and a point light.
     #[cfg(target_arch = "x86_64")]
