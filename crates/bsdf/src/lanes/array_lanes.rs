@@ -201,8 +201,9 @@ macro_rules! array_lanes {
             #[inline(always)]
             fn gather4(table: &$crate::lanes::CellTable, cell: Self) -> [Self; 4] {
                 let cells = table.$cells();
-                // One vector conversion; a negative or NaN lane indexes out of bounds (a
-                // panic, never a wrong cell).
+                // One vector conversion; a negative lane indexes out of bounds (a panic,
+                // never a wrong cell). A NaN lane reads cell 0 (`as` maps NaN to 0), where
+                // the register lanes' truncation indexes out of bounds and panics.
                 let index = lanewise!(cell.0, |a| a as i32);
                 let mut out = [[0.0 as $elem; $n]; 4];
                 for i in 0..$n {
