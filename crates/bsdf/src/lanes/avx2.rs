@@ -31,15 +31,6 @@ pub fn available() -> bool {
     std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 
-/// Whether this CPU also runs AVX-512F and AVX-512VL (the render kernel's AVX-512 build of
-/// these same eight-lane types: 32 vector registers, EVEX forms of the 256-bit operations).
-/// Implies nothing about AVX2: test [`available`] as well.
-#[inline(always)]
-pub fn avx512_available() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-}
-
 /// Eight f32 lanes in one AVX register.
 #[derive(Clone, Copy, Debug)]
 #[repr(transparent)]

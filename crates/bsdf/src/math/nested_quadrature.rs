@@ -75,7 +75,7 @@ fn k15_node(c: f64, h: f64, i: usize) -> (f64, f64, f64) {
         return (c, WGK[7] * h, WG[3] * h);
     }
     let j = i / 2;
-    let x = if i.is_multiple_of(2) {
+    let x = if i % 2 == 0 {
         c - h * XGK[j]
     } else {
         c + h * XGK[j]

@@ -81,7 +81,7 @@ impl TriangleMesh {
         if let Some(uv) = &uvs {
             check_count("uv", n, uv.len())?;
         }
-        if !indices.len().is_multiple_of(3) {
+        if indices.len() % 3 != 0 {
             return Err(GeometryError::IndexCountNotTriangles {
                 count: indices.len(),
             });

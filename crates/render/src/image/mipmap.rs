@@ -89,7 +89,7 @@ fn reduction_taps(n: usize) -> Vec<[(usize, f64); 3]> {
         return vec![[(0, 1.0), (0, 0.0), (0, 0.0)]];
     }
     let m = n / 2;
-    if n.is_multiple_of(2) {
+    if n % 2 == 0 {
         (0..m)
             .map(|i| [(2 * i, 0.5), (2 * i + 1, 0.5), (2 * i, 0.0)])
             .collect()

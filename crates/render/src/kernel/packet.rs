@@ -35,10 +35,9 @@
 //! f64 [`Bsdf`](facette_bsdf::Bsdf), lights other than environments and point lights (and
 //! maps of more than 2²⁴ pixels, which an f32 lane cannot index), area-light emission, ray
 //! differentials. On x86-64 the kernel
-//! is compiled three times, for the baseline with the SSE2 register lanes (an 8-lane f32
-//! operation is two instructions), for AVX2 + FMA with the AVX register lanes, and for the
-//! same with AVX-512F and VL (32 registers), chosen at run time; all give the same image
-//! bit for bit (tested).
+//! is compiled twice, for the baseline with the SSE2 register lanes (an 8-lane f32
+//! operation is two instructions) and for AVX2 + FMA with the AVX register lanes, chosen at
+//! run time; the two give the same image bit for bit (tested).
 
 use super::model_calls::ShadingLanes;
 use crate::geometry::bvh::lanes_of;
@@ -387,11 +386,7 @@ pub(crate) struct TileJob<'a> {
 pub(crate) fn render_tile(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
     #[cfg(target_arch = "x86_64")]
     if facette_bsdf::lanes::avx2::available() {
-        if facette_bsdf::lanes::avx2::avx512_available() {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { render_tile_avx512(job, sums) };
-        }
-        // SAFETY: as above.
+        // SAFETY: the CPU has the features the function is compiled for.
         return unsafe { render_tile_avx2(job, sums) };
     }
     render_tile_portable(job, sums)
@@ -420,17 +415,6 @@ pub(crate) fn render_tile_portable(job: &TileJob, sums: &mut Vec<PixelSums>) -> 
 type PortableLanes = F32x8Sse2;
 #[cfg(not(target_arch = "x86_64"))]
 type PortableLanes = F32x8;
-
-/// The AVX2 build's kernel (the same `F32x8Avx2` lanes, eight wide) compiled where the CPU
-/// also has AVX-512F and AVX-512VL: LLVM then has 32 vector registers instead of 16 and
-/// EVEX forms of the same 256-bit operations. The kernel's loop keeps more of its lanes in
-/// registers (measured: bench-sphere 1.47 → 1.13 s on an AMD EPYC, docs/performance.md);
-/// the operations and their order are the AVX2 build's, so the image is its bits (tested).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-unsafe fn render_tile_avx512(job: &TileJob, sums: &mut Vec<PixelSums>) -> usize {
-    render_tile_lanes::<F32x8Avx2, F32x8Avx2>(job, sums)
-}
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
@@ -1798,11 +1782,10 @@ mod tests {
         }
     }
 
-    /// The renders' AVX2 build, with its register lanes (`F32x8Avx2`), and where the CPU has
-    /// AVX-512 the AVX-512 build of the same lanes, compute the bits of the portable build's
-    /// SSE2 lanes (`F32x8Sse2`): every pixel's sums, for every sampler and estimator, on a
-    /// scene with every lane model, textures, both distributions, a conductor's complex
-    /// Fresnel, glass, an area light and a point light.
+    /// The renders' AVX2 build, with its register lanes (`F32x8Avx2`), computes the bits of
+    /// the portable build's SSE2 lanes (`F32x8Sse2`): every pixel's sums, for every sampler and
+    /// estimator, on a scene with every lane model, textures, both distributions, a
+    /// conductor's complex Fresnel, glass, an area light and a point light.
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn the_avx2_build_renders_the_portable_builds_image_bit_for_bit() {
@@ -1814,7 +1797,6 @@ mod tests {
         let (w, h) = (scene.film.width, scene.film.height);
         let chunk: Vec<u32> = (0..8).collect();
         let never = || false;
-        let mut tested_avx512 = false;
         for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
             for strategy in [Strategy::Mis, Strategy::NeeOnly, Strategy::BsdfOnly] {
                 let sampler = PixelSampler::new(kind, 5, w, h, 8);
@@ -1824,28 +1806,15 @@ mod tests {
                 // SAFETY: the CPU has AVX2 and FMA (tested above).
                 unsafe { render_tile_avx2(&job, &mut avx2) };
                 assert_eq!(portable.len(), w * h);
-                let same = |build: &str, other: &[PixelSums]| {
-                    for (k, (p, q)) in portable.iter().zip(other).enumerate() {
-                        assert_eq!(p.count(), q.count());
-                        let (a, b) = (p.sums(), q.sums());
-                        assert!(
-                            (0..3).all(|c| a[c].to_bits() == b[c].to_bits()),
-                            "{build} {kind:?} {strategy:?}, pixel {k}: {a:?} against {b:?}"
-                        );
-                    }
-                };
-                same("AVX2", &avx2);
-                if facette_bsdf::lanes::avx2::avx512_available() {
-                    let mut avx512 = Vec::new();
-                    // SAFETY: the CPU has AVX2, FMA, AVX-512F and AVX-512VL (tested).
-                    unsafe { render_tile_avx512(&job, &mut avx512) };
-                    same("AVX-512", &avx512);
-                    tested_avx512 = true;
+                for (k, (p, q)) in portable.iter().zip(&avx2).enumerate() {
+                    assert_eq!(p.count(), q.count());
+                    let (a, b) = (p.sums(), q.sums());
+                    assert!(
+                        (0..3).all(|c| a[c].to_bits() == b[c].to_bits()),
+                        "{kind:?} {strategy:?}, pixel {k}: {a:?} against {b:?}"
+                    );
                 }
             }
-        }
-        if !tested_avx512 {
-            eprintln!("this CPU has no AVX-512F + VL: the AVX-512 build cannot run here");
         }
     }
 
