@@ -88,6 +88,8 @@ import tomllib
 
 import numpy as np
 
+from host import cpu_description, load_average
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FACETTE = os.path.join(ROOT, "target", "release", "facette")
 BENCH_DIR = os.path.join(ROOT, "scenes", "bench")
@@ -251,13 +253,6 @@ def mean_sigma(a, b):
     blocks = d[:h, :w].reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean((1, 3))
     # Var(mean(a − b)) = 2 Var(mean(a)) = E[block²] / number of blocks.
     return float(np.sqrt(np.mean(blocks**2) / blocks.size / 2))
-
-
-def load_average():
-    try:
-        return " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        return "?"
 
 
 def toml_spp(path):
@@ -537,7 +532,7 @@ def main():
 
     info = (
         f"Mitsuba {mi.__version__} {mi.variant()}, {args.threads} threads,"
-        f" {os.cpu_count()} cores"
+        f" {os.cpu_count()} cores ({cpu_description()})"
     )
     load_before = load_average()
     shown = os.path.relpath(FACETTE, ROOT) if FACETTE.startswith(ROOT + os.sep) else FACETTE

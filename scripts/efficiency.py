@@ -82,6 +82,8 @@ import time
 
 import numpy as np
 
+from host import cpu_description, load_average
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FACETTE = os.path.join(ROOT, "target", "release", "facette")
 SCENE_DIR = os.path.join(ROOT, "scenes", "efficiency")
@@ -481,13 +483,6 @@ def bench_scene(name, args, variants, sampler_flag):
     return rows, bias
 
 
-def load_average():
-    try:
-        return " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        return "?"
-
-
 def markdown(all_rows, biases, args, sampler_flag, info):
     lines = [
         f"**Equal-time efficiency against Mitsuba 3** ({info}; `python3 scripts/efficiency.py"
@@ -591,7 +586,7 @@ def main():
         variants = [("facette (sampler flag unavailable)", [])]
     info = (
         f"Mitsuba {mi.__version__} {mi.variant()}, {args.threads} threads,"
-        f" {os.cpu_count()} cores"
+        f" {os.cpu_count()} cores ({cpu_description()})"
     )
     load_before = load_average()
     print(f"{info}; load average before: {load_before}")
