@@ -291,22 +291,7 @@ impl Real for F32x8Avx2 {
     fn floor(self) -> Self {
         F32x8Avx2(unsafe { _mm256_floor_ps(self.0) })
     }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        f32_polynomials::sin_cos(self)
-    }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        f32_polynomials::atan2(self, x)
-    }
-    #[inline(always)]
-    fn exp(self) -> Self {
-        f32_polynomials::exp(self)
-    }
-    #[inline(always)]
-    fn ln(self) -> Self {
-        f32_polynomials::ln(self)
-    }
+    f32_polynomials::polynomial_methods!();
     /// x − x = 0 (NaN for ±∞ and NaN): one subtraction and one compare.
     #[inline(always)]
     fn is_finite(self) -> M32x8Avx2 {

@@ -21,6 +21,31 @@ pub trait F32Lanes: Real {
     fn mask_from_bits(b: Self::Bits) -> Self::Mask;
 }
 
+/// The four [`Real`] methods every f32 lane type takes from this module (`sin_cos`, `atan2`,
+/// `exp`, `ln`), written out once for the `impl Real` blocks of the array, SSE2 and AVX2
+/// lanes.
+macro_rules! polynomial_methods {
+    () => {
+        #[inline(always)]
+        fn sin_cos(self) -> (Self, Self) {
+            $crate::lanes::f32_polynomials::sin_cos(self)
+        }
+        #[inline(always)]
+        fn atan2(self, x: Self) -> Self {
+            $crate::lanes::f32_polynomials::atan2(self, x)
+        }
+        #[inline(always)]
+        fn exp(self) -> Self {
+            $crate::lanes::f32_polynomials::exp(self)
+        }
+        #[inline(always)]
+        fn ln(self) -> Self {
+            $crate::lanes::f32_polynomials::ln(self)
+        }
+    };
+}
+pub(crate) use polynomial_methods;
+
 /// 1.5 · 2²³: adding it rounds an f32 below 2²² to the nearest integer, which its low
 /// mantissa bits then hold (the branch-free rounding of vectorized libms).
 const ROUND_MAGIC: f32 = 12_582_912.0;

@@ -52,30 +52,12 @@ array_lanes!(
     tiny = 1e-30,
     cells = f32_cells,
     {
-        #[inline(always)]
-        fn sin_cos(self) -> (Self, Self) {
-            f32_polynomials::sin_cos(self)
-        }
+        f32_polynomials::polynomial_methods!();
 
         /// ⌊x⌋ lane by lane: one `vroundps` where compiled for AVX (SSE4.1 and up).
         #[inline(always)]
         fn floor(self) -> Self {
             F32x8(lanewise!(self.0, |a| a.floor()))
-        }
-
-        #[inline(always)]
-        fn atan2(self, x: Self) -> Self {
-            f32_polynomials::atan2(self, x)
-        }
-
-        #[inline(always)]
-        fn exp(self) -> Self {
-            f32_polynomials::exp(self)
-        }
-
-        #[inline(always)]
-        fn ln(self) -> Self {
-            f32_polynomials::ln(self)
         }
     }
 );
